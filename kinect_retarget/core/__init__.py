@@ -1,0 +1,1 @@
+"""Pure numpy core: no bpy, no mathutils. Importable and testable without Blender."""

@@ -1,0 +1,113 @@
+"""Batched quaternion and rotation-matrix helpers. Quaternions are (..., 4) arrays (w, x, y, z), Hamilton.
+
+All functions broadcast over leading axes and never loop over frames in Python.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def normalize(v: np.ndarray, eps: float = 1e-12) -> np.ndarray:
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.maximum(n, eps)
+
+
+def mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product a * b (apply b first, then a)."""
+    aw, ax, ay, az = np.moveaxis(np.asarray(a, dtype=np.float64), -1, 0)
+    bw, bx, by, bz = np.moveaxis(np.asarray(b, dtype=np.float64), -1, 0)
+    return np.stack([
+        aw * bw - ax * bx - ay * by - az * bz,
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+    ], axis=-1)
+
+
+def conjugate(q: np.ndarray) -> np.ndarray:
+    return np.asarray(q, dtype=np.float64) * np.array([1.0, -1.0, -1.0, -1.0])
+
+
+def to_matrix(q: np.ndarray) -> np.ndarray:
+    """(..., 4) unit quaternions -> (..., 3, 3) rotation matrices."""
+    w, x, y, z = np.moveaxis(np.asarray(q, dtype=np.float64), -1, 0)
+    m = np.empty(w.shape + (3, 3))
+    m[..., 0, 0] = 1 - 2 * (y * y + z * z)
+    m[..., 0, 1] = 2 * (x * y - w * z)
+    m[..., 0, 2] = 2 * (x * z + w * y)
+    m[..., 1, 0] = 2 * (x * y + w * z)
+    m[..., 1, 1] = 1 - 2 * (x * x + z * z)
+    m[..., 1, 2] = 2 * (y * z - w * x)
+    m[..., 2, 0] = 2 * (x * z - w * y)
+    m[..., 2, 1] = 2 * (y * z + w * x)
+    m[..., 2, 2] = 1 - 2 * (x * x + y * y)
+    return m
+
+
+def from_matrix(m: np.ndarray) -> np.ndarray:
+    """(..., 3, 3) rotation matrices -> (..., 4) unit quaternions with w >= 0.
+
+    Picks, per matrix, the largest of 4w², 4x², 4y², 4z² as the pivot, so it is exact near 180° too.
+    """
+    m = np.asarray(m, dtype=np.float64)
+    m00, m11, m22 = m[..., 0, 0], m[..., 1, 1], m[..., 2, 2]
+    cand = np.stack([1 + m00 + m11 + m22, 1 + m00 - m11 - m22, 1 - m00 + m11 - m22, 1 - m00 - m11 + m22], -1)
+    pick = np.argmax(cand, axis=-1)
+    s = np.sqrt(np.maximum(np.take_along_axis(cand, pick[..., None], -1)[..., 0], 1e-300)) * 2  # = 4 * pivot
+    a = m[..., 2, 1] - m[..., 1, 2]
+    b = m[..., 0, 2] - m[..., 2, 0]
+    c = m[..., 1, 0] - m[..., 0, 1]
+    d = m[..., 0, 1] + m[..., 1, 0]
+    e = m[..., 0, 2] + m[..., 2, 0]
+    f = m[..., 1, 2] + m[..., 2, 1]
+    q = np.empty(m.shape[:-2] + (4,))
+    rows = [
+        (s / 4, a / s, b / s, c / s),
+        (a / s, s / 4, d / s, e / s),
+        (b / s, d / s, s / 4, f / s),
+        (c / s, e / s, f / s, s / 4),
+    ]
+    for k, row in enumerate(rows):
+        sel = pick == k
+        for i in range(4):
+            q[..., i] = np.where(sel, row[i], q[..., i]) if k else row[i]
+    q *= np.where(q[..., :1] < 0, -1.0, 1.0)
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+
+def make_continuous(q: np.ndarray, axis: int = 0) -> np.ndarray:
+    """Flip signs along `axis` (time) so consecutive quaternions lie in the same hemisphere.
+
+    q and -q are the same rotation, but keys that jump between them interpolate the long way round.
+    """
+    q = np.asarray(q, dtype=np.float64)
+    qt = np.moveaxis(q, axis, 0)
+    if qt.shape[0] < 2:
+        return q.copy()
+    dots = np.sum(qt[1:] * qt[:-1], axis=-1)
+    flips = np.concatenate([np.zeros((1,) + dots.shape[1:], dtype=bool), dots < 0], axis=0)
+    sign = np.where(np.cumsum(flips, axis=0) % 2 == 1, -1.0, 1.0)
+    return np.moveaxis(qt * sign[..., None], 0, axis)
+
+
+def angle_between(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
+    """Rotation angle (radians) between two rotations; q and -q compare as equal."""
+    r = mul(conjugate(normalize(q1)), normalize(q2))
+    return 2 * np.arctan2(np.linalg.norm(r[..., 1:], axis=-1), np.abs(r[..., 0]))
+
+
+def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Rotate (..., 3) vectors by (..., 4) quaternions."""
+    return np.einsum("...ij,...j->...i", to_matrix(q), v)
+
+
+def matrix_from_two_vectors(primary: np.ndarray, secondary: np.ndarray) -> np.ndarray:
+    """Orthonormal frames (..., 3, 3) whose columns are X, Y, Z with Y along `primary`.
+
+    Improved D-H construction of paper 000 (§2.3): X = Y × AB, Z = X × Y, with AB = `secondary`.
+    Callers keep `secondary` away from parallel to `primary` (see joint_frames).
+    """
+    y = normalize(primary)
+    x = normalize(np.cross(y, secondary))
+    z = np.cross(x, y)
+    return np.stack([x, y, z], axis=-1)

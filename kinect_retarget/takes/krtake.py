@@ -1,0 +1,141 @@
+"""The project's own take format, `.krtake` (docs/take_format.md): a JSON header line, then one text line per
+frame, `t x0 y0 z0 s0 x1 y1 z1 s1 ...`. Line-based so a live recording can append frame by frame and a
+crash loses at most the line being written.
+"""
+from __future__ import annotations
+
+import json
+import os
+from typing import IO
+
+import numpy as np
+
+from ..core.skeletons import SKELETONS, Skeleton
+from ..core.take import Take, TakeError
+
+MAGIC = "kinect_retarget.take"
+VERSION = 1
+
+
+def looks_like(head: bytes) -> bool:
+    return head.lstrip().startswith(b"{") and MAGIC.encode() in head[:400]
+
+
+def header_dict(skeleton: Skeleton, rate: float, metadata: dict | None = None) -> dict:
+    return {"format": MAGIC, "version": VERSION, "skeleton": skeleton.name, "joints": list(skeleton.joints),
+            "rate": float(rate), "units": "m", "space": "kinect_camera", "time_unit": "s",
+            "metadata": metadata or {}}
+
+
+def format_rows(times: np.ndarray, positions: np.ndarray, states: np.ndarray) -> str:
+    """Frame lines for (F,) times, (F, J, 3) positions, (F, J) states; untracked NaNs are written as 0."""
+    f, j = states.shape
+    block = np.empty((f, j, 4))
+    block[..., :3] = np.nan_to_num(positions, nan=0.0)
+    block[..., 3] = states
+    cols = np.concatenate([np.asarray(times, dtype=np.float64)[:, None], block.reshape(f, -1)], axis=1)
+    fmt = " ".join(["%.6f"] + ["%.5f %.5f %.5f %d"] * j)
+    return "".join(fmt % tuple(row) + "\n" for row in cols)
+
+
+class TakeWriter:
+    """Appends frames to a .krtake file as they arrive (live recording); flushes every frame."""
+
+    def __init__(self, path: str | os.PathLike, skeleton: Skeleton, rate: float, metadata: dict | None = None):
+        self.path = os.fspath(path)
+        self.skeleton = skeleton
+        self.frames = 0
+        self._fh: IO[str] | None = open(self.path, "w", encoding="utf-8", newline="\n")
+        self._fh.write(json.dumps(header_dict(skeleton, rate, metadata)) + "\n")
+        self._fh.flush()
+
+    def write(self, time: float, positions: np.ndarray, states: np.ndarray) -> None:
+        if self._fh is None:
+            raise ValueError(f"take writer for {self.path} is closed")
+        self._fh.write(format_rows(np.array([time]), positions[None], states[None]))
+        self._fh.flush()
+        self.frames += 1
+
+    def close(self) -> None:
+        if self._fh is not None:
+            self._fh.close()
+            self._fh = None
+
+    def __enter__(self) -> "TakeWriter":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def write(path: str | os.PathLike, take: Take) -> None:
+    with open(path, "w", encoding="utf-8", newline="\n") as fh:
+        fh.write(json.dumps(header_dict(take.skeleton, take.rate, take.metadata)) + "\n")
+        fh.write(format_rows(take.times, take.positions, take.states))
+
+
+def read(path: str | os.PathLike) -> Take:
+    path = os.fspath(path)
+    with open(path, "r", encoding="utf-8") as fh:
+        first = fh.readline()
+        body = fh.read()
+    try:
+        header = json.loads(first)
+    except json.JSONDecodeError as exc:
+        raise TakeError(f"{path}:1: take header is not valid JSON ({exc.msg})") from None
+    if header.get("format") != MAGIC:
+        raise TakeError(f"{path}:1: not a kinect_retarget take (format field is {header.get('format')!r})")
+    if header.get("version") != VERSION:
+        raise TakeError(f"{path}:1: take version {header.get('version')!r} is not supported (this reader "
+                        f"reads version {VERSION})")
+    skeleton = SKELETONS.get(header.get("skeleton", ""))
+    if skeleton is None:
+        raise TakeError(f"{path}:1: unknown skeleton {header.get('skeleton')!r} (known: {', '.join(SKELETONS)})")
+    if list(header.get("joints", skeleton.joints)) != list(skeleton.joints):
+        raise TakeError(f"{path}:1: joint list does not match skeleton {skeleton.name}")
+    ncol = 1 + 4 * len(skeleton)
+    lines = body.splitlines()
+    while lines and not lines[-1].strip():
+        lines.pop()
+    values = _parse_rows(path, lines, ncol, first_line=2)
+    if values.shape[0] == 0:
+        raise TakeError(f"{path}: take has no frames")
+    block = values[:, 1:].reshape(-1, len(skeleton), 4)
+    states = block[..., 3]
+    if np.any((states != np.round(states)) | (states < 0) | (states > 2)):
+        bad = int(np.argmax(np.any((states != np.round(states)) | (states < 0) | (states > 2), axis=1)))
+        raise TakeError(f"{path}:{bad + 2}: tracking states must be 0, 1 or 2")
+    take = _make(path, skeleton, block[..., :3], states.astype(np.uint8), values[:, 0],
+                 float(header.get("rate", 30.0)), header.get("metadata", {}))
+    return take
+
+
+def _parse_rows(path: str, lines: list[str], ncol: int, first_line: int) -> np.ndarray:
+    """Parse whitespace-separated numeric rows fast, and name the first bad line when it fails."""
+    try:
+        flat = np.array(" ".join(lines).split(), dtype=np.float64)
+    except ValueError:
+        flat = None
+    if flat is not None and flat.size == ncol * len(lines):
+        values = flat.reshape(len(lines), ncol)
+        if np.all(np.isfinite(values)):
+            return values
+    for i, line in enumerate(lines):  # slow path only to name the problem
+        parts = line.split()
+        if len(parts) != ncol:
+            raise TakeError(f"{path}:{i + first_line}: expected {ncol} values, found {len(parts)} "
+                            f"(truncated or corrupt line)")
+        try:
+            row = np.array(parts, dtype=np.float64)
+        except ValueError:
+            raise TakeError(f"{path}:{i + first_line}: non-numeric value in frame line") from None
+        if not np.all(np.isfinite(row)):
+            raise TakeError(f"{path}:{i + first_line}: NaN or infinite value")
+    raise TakeError(f"{path}: could not parse frame lines")
+
+
+def _make(path, skeleton, positions, states, times, rate, metadata) -> Take:
+    try:
+        return Take(skeleton, positions, states, times, rate, "krtake", dict(metadata))
+    except TakeError as exc:
+        raise TakeError(f"{path}: {exc}") from None
