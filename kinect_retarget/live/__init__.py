@@ -1,0 +1,1 @@
+"""Live puppeteering without bpy: queue, pump, statistics, recording and calibration maths."""

@@ -1,0 +1,155 @@
+"""The live pump, shared by the Blender timer and headless loops.
+
+`pump()` runs on the main thread: it drains the queue, feeds *every* frame through the same stateful
+pipeline as the bake (so filters see what the recording will see, and live equals baked), records every
+frame, and hands only the newest pose to `apply` (the costly bpy part). Frames drained together with a
+newer one are counted as superseded; a newest frame older than `stale_after` is not shown (stale).
+"""
+from __future__ import annotations
+
+import os
+import time
+from typing import Callable
+
+import numpy as np
+
+from ..core.skeletons import NOT_TRACKED
+from .queueing import FrameQueue
+from .recording import Recorder
+from .stats import LiveStats
+
+
+class LiveError(RuntimeError):
+    """Live had to stop: the message is for the user."""
+
+
+class LiveSession:
+    def __init__(self, source, pipeline, apply: Callable, *, queue: FrameQueue | None = None,
+                 stale_after: float = 0.25, lost_tracking_timeout: float = 2.0,
+                 clock: Callable[[], float] = time.perf_counter):
+        self.source = source
+        self.pipeline = pipeline
+        self.apply = apply
+        self.queue = queue or FrameQueue()
+        self.stale_after = stale_after
+        self.lost_tracking_timeout = lost_tracking_timeout
+        self.clock = clock
+        self.stats = LiveStats()
+        self.recorder: Recorder | None = None
+        self.error: str | None = None
+        self.running = False
+        self.last_pose = None
+        self.last_tracked_joints = 0
+        self._t0_source: float | None = None   # source clock of the first frame
+        self._t0_session = 0.0                 # session clock of the first frame
+        self._last_tracked_time: float | None = None
+
+    # -- lifecycle -------------------------------------------------------------------------------------
+    def start(self) -> None:
+        self.start_clock = self.clock()
+        if hasattr(self.pipeline, "reset"):
+            self.pipeline.reset()
+        self.source.start(self.queue)  # SourceError propagates: nothing was started
+        self.running = True
+
+    def now(self) -> float:
+        """Seconds since start on the session clock."""
+        return self.clock() - self.start_clock
+
+    def start_recording(self, path: str | os.PathLike, metadata: dict | None = None) -> Recorder:
+        if self.recorder is not None:
+            raise LiveError(f"already recording to {self.recorder.path}")
+        self.recorder = Recorder(path, self.source.skeleton, self.source.rate, self.now(), metadata)
+        return self.recorder
+
+    def stop_recording(self) -> str | None:
+        """Close the recording (whatever was written stays on disk); returns its path."""
+        rec, self.recorder = self.recorder, None
+        if rec is None:
+            return None
+        rec.close()
+        return rec.path if rec.frames else None
+
+    def stop(self, error: str | None = None) -> None:
+        """Idempotent. Ends the thread first so nothing is written after the recording closes."""
+        if error and not self.error:
+            self.error = error
+        self.source.stop()
+        if self.recorder is not None:
+            self.recorder.close()
+        self.running = False
+
+    # -- the pump --------------------------------------------------------------------------------------
+    def pump(self) -> bool:
+        """One main-thread step; returns False once live has stopped (see `error`)."""
+        if not self.running:
+            return False
+        frames = self.queue.drain()
+        newest = None
+        for frame in frames:
+            self.stats.received += 1
+            self.stats.rate.add(frame.arrival)
+            t = self._session_time(frame)
+            if self.recorder is not None:
+                self.recorder.write(t, frame.positions, frame.states)
+                self.stats.recorded += 1
+            try:
+                pose = self.pipeline.process_frame(frame.positions, frame.states, t)
+            except Exception as exc:  # the engine names the problem; live must stop, not crash the host
+                self.stop(f"retarget failed on frame {self.stats.received}: {exc}")
+                return False
+            tracked = int(np.count_nonzero(frame.states != NOT_TRACKED))
+            if pose is None or tracked == 0:
+                self.stats.untracked += 1
+                if self._lost_tracking(t):
+                    return False
+                continue
+            self._last_tracked_time = t
+            self.last_tracked_joints = tracked
+            if newest is not None:
+                self.stats.superseded += 1
+            newest = (frame, pose)
+        if newest is not None:
+            frame, pose = newest
+            if self.clock() - frame.arrival > self.stale_after:
+                self.stats.stale += 1
+            else:
+                try:
+                    self.apply(pose)
+                except Exception as exc:
+                    self.stop(f"could not pose the rig: {exc}")
+                    return False
+                self.last_pose = pose
+                self.stats.applied += 1
+                self.stats.latency.add(self.clock() - frame.arrival)
+        if self.source.error:
+            self.stop(self.source.error)
+            return False
+        if not self.source.alive and self.source.status != "running" and len(self.queue) == 0:
+            self.stop()  # the take ended: not an error
+            return False
+        return True
+
+    def _session_time(self, frame) -> float:
+        if self._t0_source is None:
+            self._t0_source = frame.time_s
+            self._t0_session = frame.arrival - self.start_clock
+        return self._t0_session + (frame.time_s - self._t0_source)
+
+    def _lost_tracking(self, t: float) -> bool:
+        since = self._last_tracked_time if self._last_tracked_time is not None else self._t0_session
+        if t - since > self.lost_tracking_timeout:
+            self.stop(f"{self.source.describe()}: no tracked joints for {t - since:.1f} s "
+                      f"(frame {self.stats.received}); is the performer in view?")
+            return True
+        return False
+
+    def statistics(self) -> dict:
+        return self.stats.as_dict(self.queue.overflowed)
+
+    def run_for(self, seconds: float, interval: float = 1 / 120) -> None:
+        """Headless loop: timers do not fire while a script blocks, so call the pump ourselves."""
+        end = self.clock() + seconds
+        while self.running and self.clock() < end:
+            self.pump()
+            time.sleep(interval)

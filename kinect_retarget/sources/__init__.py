@@ -1,0 +1,26 @@
+"""Frame sources (take playback, OSC, USB Kinect): each a thread putting whole frames on a FrameQueue."""
+from __future__ import annotations
+
+from .base import FrameSource, SourceError
+from .osc import OscReceiver
+from .playback import TakePlayback
+from .usb import UsbKinectSource
+
+
+def open_source(spec: str, speed: float = 1.0, loop: bool = False, host: str = "127.0.0.1") -> FrameSource:
+    """`take:FILE`, `osc:PORT` or `usb`, as the CLI spells them."""
+    kind, _, arg = spec.partition(":")
+    if kind == "take" and arg:
+        return TakePlayback(arg, speed=speed, loop=loop)
+    if kind == "osc":
+        try:
+            port = int(arg or 7000)
+        except ValueError:
+            raise SourceError(f"OSC port must be a number, got {arg!r}") from None
+        return OscReceiver(port, host=host)
+    if kind == "usb" and not arg:
+        return UsbKinectSource()
+    raise SourceError(f"unknown source {spec!r}: use take:FILE, osc:PORT or usb")
+
+
+__all__ = ["FrameSource", "SourceError", "TakePlayback", "OscReceiver", "UsbKinectSource", "open_source"]

@@ -1,0 +1,94 @@
+"""The USB Kinect as a frame source: wraps whatever skeleton-frame producer exists.
+
+A producer is any object with `read(timeout) -> (positions (J,3), states (J,), time_s) | None` (None: no
+skeleton this time), `skeleton` and optionally `rate` and `close()`. The depth-to-skeleton tracker is its own
+piece of work; until one is importable, this source refuses to start with a sentence that says so.
+"""
+from __future__ import annotations
+
+import importlib
+
+from .base import FrameSource, SourceError
+
+# Where a tracker may provide `open_skeleton_producer()`; first importable one wins.
+PRODUCER_MODULES = ("kinect_retarget.tracking", "kinect_retarget.device.skeleton")
+
+
+def find_skeleton_producer():
+    """(factory, None) or (None, reason) without opening the device."""
+    reasons = []
+    for name in PRODUCER_MODULES:
+        try:
+            mod = importlib.import_module(name)
+        except ImportError:
+            continue
+        except Exception as exc:  # a broken optional module must not break live for other sources
+            reasons.append(f"{name} failed to import ({type(exc).__name__}: {exc})")
+            continue
+        factory = getattr(mod, "open_skeleton_producer", None)
+        if callable(factory):
+            return factory, None
+    reasons.append("no depth-to-skeleton tracker is available yet, so the USB Kinect cannot drive a rig; "
+                   "use take playback or OSC")
+    return None, "; ".join(reasons)
+
+
+def usb_status() -> str:
+    """One line for the panel, without touching the device."""
+    factory, reason = find_skeleton_producer()
+    return "tracker available" if factory else reason
+
+
+class UsbKinectSource(FrameSource):
+    kind = "usb"
+
+    def __init__(self, producer=None, factory=None):
+        self._producer = producer
+        self._factory = factory
+        skeleton = getattr(producer, "skeleton", None)
+        if skeleton is None:
+            from ..core.skeletons import KINECT_V1
+            skeleton = KINECT_V1  # the Kinect v1 joint set, which a USB Kinect v1 tracker reports
+        super().__init__(skeleton, getattr(producer, "rate", 30.0))
+
+    def describe(self) -> str:
+        return "USB Kinect"
+
+    def _open(self) -> None:
+        if self._producer is None:
+            factory = self._factory
+            if factory is None:
+                factory, reason = find_skeleton_producer()
+                if factory is None:
+                    raise SourceError(f"USB Kinect: {reason}")
+            try:
+                self._producer = factory()
+            except SourceError:
+                raise
+            except Exception as exc:  # unplugged device, permissions, libusb missing
+                raise SourceError(f"USB Kinect: cannot open the device ({exc})") from None
+            self.skeleton = getattr(self._producer, "skeleton", self.skeleton)
+            self.rate = float(getattr(self._producer, "rate", self.rate))
+
+    def _close(self) -> None:
+        close = getattr(self._producer, "close", None)
+        if callable(close):
+            try:
+                close()
+            except Exception:
+                pass  # closing an unplugged device may fail; the thread is gone either way
+
+    def _run(self) -> None:
+        n = 0
+        while not self.stopping:
+            try:
+                frame = self._producer.read(0.1)
+            except SourceError:
+                raise
+            except Exception as exc:
+                raise SourceError(f"USB Kinect stopped delivering frames ({exc})") from None
+            if frame is None:
+                continue
+            positions, states, time_s = frame
+            self._emit(positions, states, time_s, where=f" frame {n}")
+            n += 1
