@@ -59,7 +59,7 @@ class StandInPipeline:
         p = np.asarray(positions, dtype=np.float64)
         self.state = p if self.state is None else 0.5 * self.state + 0.5 * p
         return SimpleNamespace(root_location=self.state[0].copy(), quats=np.tile([1.0, 0, 0, 0], (3, 1)),
-                               time_s=time_s)
+                               time_s=time_s, index=self.calls - 1)
 
 
 @pytest.fixture
