@@ -10,8 +10,10 @@ import importlib
 
 from .base import FrameSource, SourceError
 
-# Where a tracker may provide `open_skeleton_producer()`; first importable one wins.
-PRODUCER_MODULES = ("kinect_retarget.tracking", "kinect_retarget.device.skeleton")
+# Where a tracker may provide `open_skeleton_producer()`; first importable one wins. Relative to the package,
+# which is `bl_ext.<repo>.kinect_retarget` when installed as an extension.
+PRODUCER_MODULES = (".tracking", ".device.skeleton")
+_ROOT = __package__.rpartition(".")[0]
 
 
 def find_skeleton_producer():
@@ -19,7 +21,7 @@ def find_skeleton_producer():
     reasons = []
     for name in PRODUCER_MODULES:
         try:
-            mod = importlib.import_module(name)
+            mod = importlib.import_module(name, _ROOT)
         except ImportError:
             continue
         except Exception as exc:  # a broken optional module must not break live for other sources
