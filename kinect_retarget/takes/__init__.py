@@ -11,7 +11,7 @@ from importlib import import_module
 from ..core.take import Take, TakeError
 
 # Tried in order: the most specific signatures first.
-READERS = ("krtake",)
+READERS = ("krtake", "bvh")
 
 
 def detect_format(path: str | os.PathLike) -> str:
