@@ -14,6 +14,7 @@ from typing import Callable
 import numpy as np
 
 from ..core.skeletons import NOT_TRACKED
+from .calibration import CalibrationCapture
 from .queueing import FrameQueue
 from .recording import Recorder
 from .stats import LiveStats
@@ -43,6 +44,7 @@ class LiveSession:
         self._t0_source: float | None = None   # source clock of the first frame
         self._t0_session = 0.0                 # session clock of the first frame
         self._last_tracked_time: float | None = None
+        self._calibration: tuple[CalibrationCapture, Callable] | None = None
 
     # -- lifecycle -------------------------------------------------------------------------------------
     def start(self) -> None:
@@ -70,6 +72,14 @@ class LiveSession:
         rec.close()
         return rec.path if rec.frames else None
 
+    def start_calibration(self, done: Callable[[CalibrationCapture], None], duration: float = 1.0) -> None:
+        """Collect `duration` seconds of frames; `done(capture)` runs on the main thread when full."""
+        self._calibration = (CalibrationCapture(duration), done)
+
+    @property
+    def calibrating(self) -> bool:
+        return self._calibration is not None
+
     def stop(self, error: str | None = None) -> None:
         """Idempotent. Ends the thread first so nothing is written after the recording closes."""
         if error and not self.error:
@@ -93,6 +103,10 @@ class LiveSession:
             if self.recorder is not None:
                 self.recorder.write(t, frame.positions, frame.states)
                 self.stats.recorded += 1
+            if self._calibration is not None and self._calibration[0].add(t, frame.positions, frame.states):
+                capture, done = self._calibration
+                self._calibration = None
+                done(capture)
             try:
                 pose = self.pipeline.process_frame(frame.positions, frame.states, t)
             except Exception as exc:  # the engine names the problem; live must stop, not crash the host
