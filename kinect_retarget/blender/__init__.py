@@ -1,0 +1,1 @@
+"""Everything that touches bpy. Nothing outside this package imports bpy or mathutils."""

@@ -1,0 +1,92 @@
+"""Bake a take onto an armature: the one function behind the operator, the CLI and the demo."""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import Callable
+
+import bpy
+import numpy as np
+
+from ..core.kinect_rig_layout import median_segment_lengths
+from ..core.pipeline import BakedMotion, RetargetPipeline, RetargetSettings
+from ..core.presets import RIGIFY_FK_SWITCHES, build_mapping
+from ..core.take import Take
+from .bake import bake_motion
+from .evaluated_solve import correct_for_evaluation
+from .kinect_rig import build_kinect_rig
+from .rig_reader import has_constrained_ancestry, target_rig_from_object
+
+Report = Callable[[set, str], None]
+
+
+@dataclass
+class BakeResult:
+    action: bpy.types.Action
+    motion: BakedMotion
+    preset: str
+    frame_range: tuple[int, int]
+
+
+def _no_report(level: set, message: str) -> None:
+    pass
+
+
+def new_generated_rig(scene: bpy.types.Scene, take: Take, name: str = "KinectRig") -> bpy.types.Object:
+    return build_kinect_rig(scene, take.skeleton, median_segment_lengths(take), name)
+
+
+def make_pipeline(obj: bpy.types.Object, take: Take, preset: str = "auto",
+                  overrides: dict[str, str] | None = None,
+                  settings: RetargetSettings | None = None) -> tuple[RetargetPipeline, str]:
+    rig = target_rig_from_object(obj)
+    used, mapping = build_mapping(preset, rig.bone_names, overrides)
+    return RetargetPipeline(take.skeleton, rig, mapping, settings), used
+
+
+def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
+              overrides: dict[str, str] | None = None, settings: RetargetSettings | None = None,
+              action_name: str | None = None, set_scene_range: bool = True,
+              report: Report = _no_report, progress: Callable[[float], None] | None = None) -> BakeResult:
+    """Retarget `take` onto armature `obj` and key it into a new Action assigned to `obj`.
+
+    Only pose channels are keyed; the rig's bones, rolls, constraints and settings are left as they are.
+    Raises ValueError (wrong armature, no mapped bone) before anything in the scene changes.
+    """
+    settings = settings or RetargetSettings()
+    pipeline, used = make_pipeline(obj, take, preset, overrides, settings)
+    motion = pipeline.process_take(take)
+    if progress:
+        progress(0.3)
+    extra = []
+    if used == "rigify":
+        extra = [(f'pose.bones["{b}"]["IK_FK"]', b, np.ones((1, 1))) for b in RIGIFY_FK_SWITCHES
+                 if b in obj.pose.bones and "IK_FK" in obj.pose.bones[b]]
+    if has_constrained_ancestry(obj, motion.bone_names):
+        saved = {name: obj.pose.bones[name].get("IK_FK") for _, name, _ in extra}
+        for _, name, _ in extra:
+            obj.pose.bones[name]["IK_FK"] = 1.0
+        n = len(motion.frames)
+        motion.quats = correct_for_evaluation(
+            obj, motion.bone_names, motion.quats, motion.root_bone, motion.root_location,
+            motion.extras["desired"], (lambda f: progress(0.3 + 0.6 * f / n)) if progress else None)
+        for name, value in saved.items():
+            if value is not None:
+                obj.pose.bones[name]["IK_FK"] = value
+    name = action_name or f"{obj.name}_{take.metadata.get('name', 'take')}"
+    action = bake_motion(obj, motion, name, extra)
+    first, last = int(motion.frames[0]), int(motion.frames[-1])
+    if set_scene_range:
+        scene = bpy.context.scene
+        scene.render.fps = max(1, int(round(motion.fps)))
+        scene.render.fps_base = scene.render.fps / motion.fps
+        scene.frame_start, scene.frame_end = first, last
+    report({"INFO"}, f"Baked {len(motion.frames)} frames ({len(motion.bone_names)} bones, preset {used}) "
+                     f"onto {obj.name!r} as action {action.name!r}")
+    if progress:
+        progress(1.0)
+    return BakeResult(action, motion, used, (first, last))
+
+
+def take_display_name(path: str) -> str:
+    return os.path.splitext(os.path.basename(path))[0]

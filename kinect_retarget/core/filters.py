@@ -1,0 +1,190 @@
+"""Jitter filters on joint positions (paper 000 names jitter filtering as future work), applied before the
+rotations are computed.
+
+Both filters are causal and stateful: `step()` filters one frame (live), `run()` steps through a whole take
+(bake), so a live pose equals the baked pose for the same frame. Work is vectorised over joints; the loop over
+frames is inherent to a recursive filter.
+
+Untracked joints (state 0) hold their last filtered position and restart their history when they come back;
+inferred joints (state 1) are filtered like tracked ones.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .skeletons import NOT_TRACKED
+
+
+@dataclass
+class DoubleExponentialFilter:
+    """The Kinect SDK's joint filter (Holt double exponential smoothing with a jitter radius and a maximum
+    deviation from the raw data), with the SDK's default parameters."""
+
+    smoothing: float = 0.5
+    correction: float = 0.5
+    prediction: float = 0.5
+    jitter_radius: float = 0.05
+    max_deviation: float = 0.04
+
+    def __post_init__(self) -> None:
+        self.reset()
+
+    def reset(self) -> None:
+        self._filtered = self._trend = self._raw = self._out = None
+        self._count = None
+
+    def step(self, x: np.ndarray, states: np.ndarray, t: float | None = None) -> np.ndarray:
+        x = np.asarray(x, dtype=np.float64)
+        valid = (np.asarray(states) != NOT_TRACKED)[:, None]
+        if self._filtered is None:
+            n = x.shape[0]
+            self._filtered, self._trend = x.copy(), np.zeros_like(x)
+            self._raw, self._out = x.copy(), x.copy()
+            self._count = np.zeros((n, 1))
+        count = self._count
+        prev_f, prev_t = self._filtered, self._trend
+        first = count == 0
+        second = count == 1
+        # jitter radius: small moves are pulled toward the last estimate in proportion to their size
+        diff = x - prev_f
+        dist = np.sqrt(np.sum(diff * diff, axis=1, keepdims=True))
+        w = np.minimum(dist / self.jitter_radius, 1.0)
+        damped = prev_f + diff * w
+        filtered = damped * (1 - self.smoothing) + (prev_f + prev_t) * self.smoothing
+        filtered = np.where(second, (x + self._raw) * 0.5, filtered)
+        filtered = np.where(first, x, filtered)
+        trend = (filtered - prev_f) * self.correction + prev_t * (1 - self.correction)
+        trend = np.where(first, 0.0, trend)
+        predicted = filtered + trend * self.prediction
+        dev = predicted - x
+        dlen = np.sqrt(np.sum(dev * dev, axis=1, keepdims=True))
+        over = dlen > self.max_deviation
+        predicted = np.where(over, x + dev * (self.max_deviation / np.maximum(dlen, 1e-12)), predicted)
+        self._filtered = np.where(valid, filtered, prev_f)
+        self._trend = np.where(valid, trend, 0.0)
+        self._raw = np.where(valid, x, self._raw)
+        self._out = np.where(valid, predicted, self._out)
+        self._count = np.where(valid, count + 1, 0.0)
+        return self._out.copy()
+
+    def run(self, positions: np.ndarray, states: np.ndarray, times: np.ndarray | None = None) -> np.ndarray:
+        out = np.empty_like(np.asarray(positions, dtype=np.float64))
+        for i in range(out.shape[0]):
+            out[i] = self.step(positions[i], states[i])
+        return out
+
+
+@dataclass
+class OneEuroFilter:
+    """One-Euro filter (Casiez et al. 2012): a low-pass whose cutoff rises with speed, per coordinate."""
+
+    min_cutoff: float = 1.0   # Hz
+    beta: float = 2.0         # cutoff increase per m/s
+    d_cutoff: float = 1.0     # Hz, for the speed estimate
+    rate: float = 30.0        # used for the first step only
+
+    def __post_init__(self) -> None:
+        self.reset()
+
+    def reset(self) -> None:
+        self._x = self._dx = self._t = None
+
+    @staticmethod
+    def _alpha(cutoff, dt):
+        tau = 1.0 / (2 * math.pi * cutoff)
+        return 1.0 / (1.0 + tau / dt)
+
+    def step(self, x: np.ndarray, states: np.ndarray, t: float | None = None) -> np.ndarray:
+        x = np.asarray(x, dtype=np.float64)
+        valid = (np.asarray(states) != NOT_TRACKED)[:, None]
+        if self._x is None:
+            self._x, self._dx = x.copy(), np.zeros_like(x)
+            self._seen = valid.copy()
+            self._t = t
+            return x.copy()
+        dt = 1.0 / self.rate if t is None or self._t is None or t <= self._t else t - self._t
+        self._t = t
+        dx = (x - self._x) / dt
+        dx_hat = self._dx + self._alpha(self.d_cutoff, dt) * (dx - self._dx)
+        cutoff = self.min_cutoff + self.beta * np.abs(dx_hat)
+        a = 1.0 / (1.0 + 1.0 / (2 * math.pi * cutoff * dt))
+        x_hat = self._x + a * (x - self._x)
+        restart = valid & ~self._seen  # a joint coming back starts from its raw position
+        x_hat = np.where(restart, x, x_hat)
+        self._x = np.where(valid, x_hat, self._x)
+        self._dx = np.where(valid & ~restart, dx_hat, 0.0)
+        self._seen = valid
+        return self._x.copy()
+
+    def run(self, positions: np.ndarray, states: np.ndarray, times: np.ndarray | None = None) -> np.ndarray:
+        out = np.empty_like(np.asarray(positions, dtype=np.float64))
+        for i in range(out.shape[0]):
+            out[i] = self.step(positions[i], states[i], None if times is None else float(times[i]))
+        return out
+
+
+class HoldUntracked:
+    """No smoothing: untracked joints hold their last position ('none' keeps even those as recorded)."""
+
+    def __init__(self) -> None:
+        self.reset()
+
+    def reset(self) -> None:
+        self._last = None
+
+    def step(self, x, states, t=None):
+        x = np.asarray(x, dtype=np.float64)
+        valid = (np.asarray(states) != NOT_TRACKED)[:, None]
+        self._last = x.copy() if self._last is None else np.where(valid, x, self._last)
+        return self._last.copy()
+
+    def run(self, positions, states, times=None):
+        positions = np.asarray(positions, dtype=np.float64)
+        out = np.empty_like(positions)
+        for i in range(positions.shape[0]):
+            out[i] = self.step(positions[i], states[i])
+        return out
+
+
+FILTERS = ("none", "default", "one_euro", "kinect_sdk", "hold")
+
+
+def make_filter(name: str, rate: float = 30.0):
+    """None for 'none' (every position honoured, whatever its state). 'default' is a One-Euro filter tuned on
+    the real Kinect v2 takes (jitter cut to under half, lag under one frame; benchmarks/bench_filters.py);
+    'kinect_sdk' is the SDK's double exponential filter with its default parameters; 'hold' only holds
+    untracked joints."""
+    if name == "none":
+        return None
+    if name in ("default", "one_euro"):
+        return OneEuroFilter(min_cutoff=1.0, beta=4.0, rate=rate)
+    if name == "kinect_sdk":
+        return DoubleExponentialFilter()
+    if name == "hold":
+        return HoldUntracked()
+    raise ValueError(f"unknown filter {name!r} (choose from {', '.join(FILTERS)})")
+
+
+def jitter(positions: np.ndarray) -> float:
+    """Mean frame-to-frame joint acceleration magnitude (m/frame²)."""
+    acc = positions[2:] - 2 * positions[1:-1] + positions[:-2]
+    return float(np.mean(np.linalg.norm(acc, axis=-1)))
+
+
+def lag_frames(raw: np.ndarray, filtered: np.ndarray, max_lag: float = 5.0) -> float:
+    """Delay of `filtered` behind `raw`, in frames (sub-frame), from the shift that best aligns them."""
+    shifts = np.arange(0.0, max_lag + 1e-9, 0.05)
+    n = raw.shape[0]
+    t = np.arange(n, dtype=np.float64)
+    errs = []
+    for s in shifts:  # compare filtered(t) with raw(t - s), raw linearly interpolated
+        ts = t[int(math.ceil(s)):] - s
+        lo = np.floor(ts).astype(int)
+        frac = (ts - lo)[:, None, None]
+        hi = np.minimum(lo + 1, n - 1)
+        shifted = raw[lo] * (1 - frac) + raw[hi] * frac
+        errs.append(np.mean(np.sum((filtered[int(math.ceil(s)):] - shifted) ** 2, axis=-1)))
+    return float(shifts[int(np.argmin(errs))])

@@ -1,0 +1,129 @@
+"""Joint orientation frames from neighbouring joints (paper 000, §2.3, "improved D-H"), made robust.
+
+A frame is a (..., 3, 3) rotation whose columns are X, Y, Z. Y runs along the segment (parent joint ->
+joint, paper step 1); X comes from a second, sideways vector (paper step 2-3: X = Y × AB) and Z = X × Y
+(step 4). Which sideways vector a segment uses depends on its role in the body:
+
+* torso, neck, head, pelvis: AB is the left-right line of the hips or shoulders, so twist follows the body;
+* clavicles and hips: AB is the spine's up direction;
+* arms and legs: X is the hinge axis of the elbow or knee (upper × lower segment). Both bones of a limb and
+  the hand or foot share it, so the elbow and knee bend about one axis and never twist like a candy wrapper.
+  A straight limb has no bend plane; the hinge then blends smoothly into an anatomical default (elbows bend
+  toward the chest's front, knees about the hips' left-right axis).
+
+The same rules build the target rig's rest frames from its rest joint positions, so rest-pose differences
+(A-pose or T-pose) cancel out (see retarget.py).
+"""
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+from .quat import normalize
+
+# Canonical joint names are Kinect v1's; Kinect v2 names that differ resolve through these aliases.
+ALIASES = {"HipCenter": ("HipCenter", "SpineBase"), "Spine": ("Spine", "SpineMid"),
+           "ShoulderCenter": ("ShoulderCenter", "SpineShoulder")}
+
+# role of the segment that ends at a joint (the joint at the bone's tail)
+ROLES = {
+    "HipCenter": "pelvis", "SpineBase": "pelvis", "Spine": "spine", "SpineMid": "spine",
+    "ShoulderCenter": "chest", "SpineShoulder": "chest", "Neck": "neck", "Head": "head",
+    "Shoulder": "clavicle", "Elbow": "upper_arm", "Wrist": "forearm", "Hand": "hand", "HandTip": "hand",
+    "Thumb": "hand", "Hip": "hip", "Knee": "thigh", "Ankle": "shin", "Foot": "foot",
+}
+HINGE_BLEND = 0.1  # weight of the default hinge: it takes over below a bend of about 6 degrees
+
+GetJoint = Callable[[str], "np.ndarray | None"]
+
+
+def role_and_side(joint: str) -> tuple[str, str]:
+    for side in ("Left", "Right"):
+        if joint.endswith(side):
+            return ROLES[joint[: -len(side)]], side
+    return ROLES[joint], ""
+
+
+def resolver(names: tuple[str, ...], positions: np.ndarray) -> GetJoint:
+    """Lookup of (..., 3) joint positions by canonical name; None when the skeleton lacks the joint."""
+    index = {n: i for i, n in enumerate(names)}
+
+    def get(name: str):
+        for alias in ALIASES.get(name, (name,)):
+            if alias in index:
+                return positions[..., index[alias], :]
+        return None
+    return get
+
+
+def frame_from_y_hint(y: np.ndarray, hint: np.ndarray) -> np.ndarray:
+    """Frames with Y along `y` and X as close to `hint` as possible; X = Y × AB in the paper's terms."""
+    y = normalize(y)
+    x = hint - np.sum(hint * y, axis=-1, keepdims=True) * y
+    # A hint parallel to Y leaves X undefined; pick any perpendicular so output stays finite.
+    bad = np.linalg.norm(x, axis=-1) < 1e-9
+    if np.any(bad):
+        alt = np.where(np.abs(y[..., :1]) < 0.9, np.array([1.0, 0, 0]), np.array([0, 0, 1.0]))
+        x = np.where(bad[..., None], np.cross(y, np.cross(alt, y)), x)
+    x = normalize(x)
+    z = np.cross(x, y)
+    return np.stack([x, y, z], axis=-1)
+
+
+def _sub(a, b):
+    return None if a is None or b is None else a - b
+
+
+def lateral(get: GetJoint, upper: bool, fallback: np.ndarray) -> np.ndarray:
+    """Performer's right-to-left direction from shoulders (upper) or hips, whichever exists first."""
+    pairs = [("ShoulderLeft", "ShoulderRight"), ("HipLeft", "HipRight")]
+    for left, right in (pairs if upper else pairs[::-1]):
+        v = _sub(get(left), get(right))
+        if v is not None:
+            return v
+    return np.broadcast_to(fallback, np.shape(fallback))
+
+
+def up_vector(get: GetJoint, fallback: np.ndarray) -> np.ndarray:
+    v = _sub(get("ShoulderCenter"), get("HipCenter"))
+    if v is None:
+        v = _sub(get("Head"), get("HipCenter"))
+    return fallback if v is None else v
+
+
+def hinge_axis(get: GetJoint, side: str, kind: str, y_upper: np.ndarray, world_lateral: np.ndarray,
+               world_up: np.ndarray) -> np.ndarray:
+    """Hinge axis of the elbow (kind 'arm') or knee ('leg') on one side; (..., 3), not normalised."""
+    a, b, c = (("Shoulder", "Elbow", "Wrist") if kind == "arm" else ("Hip", "Knee", "Ankle"))
+    upper = _sub(get(b + side), get(a + side))
+    lower = _sub(get(c + side), get(b + side))
+    y_upper = normalize(y_upper)
+    bend = np.zeros_like(y_upper) if upper is None or lower is None else np.cross(
+        normalize(upper), normalize(lower))
+    lat = normalize(lateral(get, upper=(kind == "arm"), fallback=world_lateral))
+    if kind == "arm":
+        forward = np.cross(lat, normalize(up_vector(get, world_up)))
+        # the small -lateral term settles the arm-straight-forward case, where y × forward vanishes
+        default = np.cross(y_upper, forward) - 0.05 * lat
+    else:
+        default = lat
+    default = default - np.sum(default * y_upper, axis=-1, keepdims=True) * y_upper
+    return bend + HINGE_BLEND * normalize(default)
+
+
+def segment_hint(get: GetJoint, tail: str, y: np.ndarray, world_lateral: np.ndarray,
+                 world_up: np.ndarray) -> np.ndarray:
+    """The X-direction hint for the segment ending at joint `tail` whose direction is `y`."""
+    role, side = role_and_side(tail)
+    if role in ("pelvis", "spine"):
+        return np.cross(y, lateral(get, upper=False, fallback=world_lateral))
+    if role in ("chest", "neck", "head"):
+        return np.cross(y, lateral(get, upper=True, fallback=world_lateral))
+    if role in ("clavicle", "hip"):
+        return np.cross(y, up_vector(get, world_up))
+    if role in ("upper_arm", "forearm", "hand"):
+        upper = _sub(get("Elbow" + side), get("Shoulder" + side))
+        return hinge_axis(get, side, "arm", y if upper is None else upper, world_lateral, world_up)
+    upper = _sub(get("Knee" + side), get("Hip" + side))
+    return hinge_axis(get, side, "leg", y if upper is None else upper, world_lateral, world_up)

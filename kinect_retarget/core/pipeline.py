@@ -1,0 +1,135 @@
+"""Take or frame in, pose-bone rotations and root location out: filter -> joint frames -> retarget.
+
+The bake (`process_take`) and live (`process_frame`) paths share the filter state machine and the solver,
+so a live pose equals the baked pose for the same frame and settings.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .conventions import mirror_positions
+from .filters import FILTERS, make_filter
+from .joint_frames import resolver
+from .quat import make_continuous
+from .retarget import ROOT_MODES, Retargeter, leg_length
+from .skeletons import NOT_TRACKED, Skeleton
+from .take import Take, TakeError
+from .target_rig import TargetRig
+
+
+@dataclass(frozen=True)
+class RetargetSettings:
+    filter: str = "default"          # see filters.FILTERS
+    root_mode: str = "xyz"           # xyz | xy (no vertical motion) | none
+    fps: float | None = None         # scene rate; None = the take's nominal rate
+    frame_start: int = 1
+    mirror: bool = False             # swap the performer's left and right
+    root_scale: float | None = None  # n of eq. 13; None = target leg / source leg (1 on the generated rig)
+
+    def __post_init__(self) -> None:
+        if self.filter not in FILTERS:
+            raise ValueError(f"unknown filter {self.filter!r} (choose from {', '.join(FILTERS)})")
+        if self.root_mode not in ROOT_MODES:
+            raise ValueError(f"unknown root mode {self.root_mode!r} (choose from {', '.join(ROOT_MODES)})")
+        if self.fps is not None and not self.fps > 0:
+            raise ValueError(f"fps must be positive, got {self.fps}")
+
+
+@dataclass
+class BakedMotion:
+    """Keys for one rig: frames (N,) scene frames, quats (N, M, 4) wxyz sign-continuous for bone_names,
+    root_location (N, 3) pose location of root_bone; samples (N,) the take sample each key came from."""
+
+    frames: np.ndarray
+    bone_names: tuple[str, ...]
+    quats: np.ndarray
+    root_bone: str | None
+    root_location: np.ndarray
+    fps: float
+    samples: np.ndarray
+    extras: dict = field(default_factory=dict)
+
+
+@dataclass
+class FramePose:
+    bone_names: tuple[str, ...]
+    quats: np.ndarray          # (M, 4)
+    root_bone: str | None
+    root_location: np.ndarray  # (3,)
+    time: float
+
+
+class RetargetPipeline:
+    def __init__(self, skeleton: Skeleton, rig: TargetRig, mapping: dict[str, str],
+                 settings: RetargetSettings | None = None):
+        self.skeleton, self.rig = skeleton, rig
+        self.settings = settings or RetargetSettings()
+        self.retargeter = Retargeter(skeleton, rig, mapping, root_mode=self.settings.root_mode,
+                                     root_scale=self.settings.root_scale)
+        self.source_leg: float | None = None  # set by calibrate(); process_take measures it when unset
+        self.reset()
+
+    @property
+    def bone_names(self) -> tuple[str, ...]:
+        return self.retargeter.bone_names
+
+    @property
+    def root_bone(self) -> str | None:
+        return self.retargeter.root.bone if self.retargeter.root else None
+
+    def reset(self, rate: float = 30.0) -> None:
+        """Forget filter history and the root reference (a new take or a new live session)."""
+        self.filter = make_filter(self.settings.filter, rate)
+        self.root_reference: np.ndarray | None = None
+
+    def calibrate(self, positions: np.ndarray) -> float | None:
+        """Fix the source leg length (root scale n) from (F, J, 3) frames of the performer standing."""
+        p = self._mirrored(np.asarray(positions, dtype=np.float64))
+        self.source_leg = leg_length(resolver(self.skeleton.joints, p))
+        return self.source_leg
+
+    def _mirrored(self, positions: np.ndarray) -> np.ndarray:
+        return mirror_positions(positions, self.skeleton.mirror) if self.settings.mirror else positions
+
+    def _filtered(self, positions, states, times) -> np.ndarray:
+        if self.settings.mirror:
+            states = states[..., self.skeleton.mirror]
+        positions = self._mirrored(positions)
+        if self.filter is None:
+            return positions
+        return self.filter.run(positions, states, times)
+
+    def process_take(self, take: Take) -> BakedMotion:
+        if take.skeleton.name != self.skeleton.name:
+            raise TakeError(f"take skeleton {take.skeleton.name} does not match pipeline {self.skeleton.name}")
+        fps = float(self.settings.fps or take.rate)
+        self.reset(take.rate)
+        keyed = np.flatnonzero(take.any_tracked)
+        if keyed.size == 0:
+            raise TakeError("take has no frame with a tracked joint: nothing to bake")
+        positions = self._filtered(take.positions[keyed], take.states[keyed], take.times[keyed])
+        if self.source_leg is None:
+            self.source_leg = leg_length(resolver(self.skeleton.joints, positions))
+        self.root_reference = positions[0, self.skeleton.root].copy()
+        frames = self.settings.frame_start + np.round((take.times[keyed] - take.times[0]) * fps).astype(np.int64)
+        first = np.concatenate([[True], np.diff(frames) > 0])  # one key per scene frame: the first sample
+        quats, location, desired = self.retargeter.solve(positions[first], self.root_reference, self.source_leg,
+                                                         want_desired=True)
+        return BakedMotion(frames[first], self.bone_names, make_continuous(quats, axis=0), self.root_bone,
+                           location, fps, keyed[first], {"desired": desired, "positions": positions[first]})
+
+    def process_frame(self, positions: np.ndarray, states: np.ndarray, time: float) -> FramePose | None:
+        """One live frame; None when no joint is tracked (nothing to apply, filter untouched)."""
+        states = np.asarray(states)
+        positions = np.asarray(positions, dtype=np.float64)
+        if not np.any(states != NOT_TRACKED):
+            return None
+        if not np.all(np.isfinite(positions[states != NOT_TRACKED])):
+            raise ValueError("frame has NaN or infinite positions for tracked joints")
+        p = self._filtered(positions[None], states[None], np.array([time]))[0]
+        if self.root_reference is None:
+            self.root_reference = p[self.skeleton.root].copy()
+        quats, location = self.retargeter.solve(p[None], self.root_reference, self.source_leg)
+        return FramePose(self.bone_names, quats[0], self.root_bone, location[0], float(time))

@@ -1,0 +1,207 @@
+"""Parent-relative bone rotations and root motion for a target rig (paper 000, §2.4–2.5, eq. 10–13).
+
+For every mapped bone b, with source joint frame O_s(t) (joint_frames.py) and the frame O_t the same rules
+give on the target's rest pose:
+
+    desired armature-space rotation   D_b(t) = O_s(t) · O_tᵀ · R_rest(b)                      (eq. 11)
+    pose-bone rotation                Q_b(t) = (P_parent(t) · R_rel(b))ᵀ · D_b(t)           (eq. 12)
+
+O_s(t)·O_tᵀ is the paper's bone rotation matrix between two configurations (the target rest pose standing in
+for the paper's fixed initial pose, §2.2), so the bone's Y axis points exactly along the performer's segment
+and its twist follows the joint frame. Everything is computed from the rig's rest matrices; the rig itself
+is never changed. The root bone's head follows the root joint's displacement times n (eq. 13).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .conventions import KINECT_TO_BLENDER
+from .joint_frames import ALIASES, frame_from_y_hint, resolver, segment_hint
+from .quat import from_matrix
+from .skeletons import Skeleton
+from .target_rig import TargetRig, _topological
+
+ROOT_MODES = ("xyz", "xy", "none")
+
+
+@dataclass(frozen=True)
+class MappedBone:
+    bone: str
+    index: int      # in the target rig
+    head: int       # source joint indices of the segment
+    tail: int
+    tail_name: str  # canonical role lookup name (source skeleton's joint name)
+    is_root: bool
+
+
+def resolve_joint(skeleton: Skeleton, name: str) -> int:
+    for alias in ALIASES.get(name, (name,)):
+        if alias in skeleton.joints:
+            return skeleton.index(alias)
+    for canonical, aliases in ALIASES.items():  # a v2 name asked of a v1 skeleton
+        if name in aliases and canonical in skeleton.joints:
+            return skeleton.index(canonical)
+    raise KeyError(name)
+
+
+def resolve_mapping(skeleton: Skeleton, rig: TargetRig, mapping: dict[str, str]) -> list[MappedBone]:
+    """mapping: target bone -> source joint spec: 'ElbowLeft' (segment from the joint's parent to it),
+    'ShoulderLeft>ElbowLeft' (explicit head>tail), or the root joint's name for the pelvis/root bone.
+    Bones absent from the rig and joints absent from the skeleton are skipped (left alone)."""
+    out = []
+    for bone, spec in mapping.items():
+        if not spec or not rig.has(bone):
+            continue
+        try:
+            if ">" in spec:
+                head, tail = (resolve_joint(skeleton, s.strip()) for s in spec.split(">"))
+            else:
+                tail = resolve_joint(skeleton, spec)
+                head = skeleton.parents[tail]
+        except KeyError:
+            continue
+        is_root = head == -1
+        if is_root:  # pelvis frame: up toward the first spine joint, twist from the hips
+            head, tail = tail, resolve_joint(skeleton, "Spine")
+        tail_name = skeleton.joints[head] if is_root else skeleton.joints[tail]
+        out.append(MappedBone(bone, rig.index(bone), head, tail, tail_name, is_root))
+    return out
+
+
+def target_joint_positions(skeleton: Skeleton, rig: TargetRig, mapped: list[MappedBone]) -> np.ndarray:
+    """Estimated rest positions of the source joints on the target (armature space), NaN where unknown.
+    Tails of mapped bones first, heads fill the rest (a thigh's head is the hip joint)."""
+    pos = np.full((len(skeleton), 3), np.nan)
+    for m in mapped:
+        if not m.is_root:
+            pos[m.tail] = rig.tails[m.index]
+    for m in mapped:
+        if np.isnan(pos[m.head, 0]):
+            pos[m.head] = rig.heads[m.index]
+    return pos
+
+
+def leg_length(get) -> float | None:
+    """Mean of left and right hip->knee + knee->ankle lengths (median over frames), or None."""
+    lengths = []
+    for side in ("Left", "Right"):
+        hip, knee, ankle = get("Hip" + side), get("Knee" + side), get("Ankle" + side)
+        if hip is None or knee is None or ankle is None:
+            continue
+        seg = np.linalg.norm(knee - hip, axis=-1) + np.linalg.norm(ankle - knee, axis=-1)
+        seg = seg[np.isfinite(seg)]
+        if seg.size:
+            lengths.append(float(np.median(seg)))
+    return float(np.mean(lengths)) if lengths else None
+
+
+class Retargeter:
+    """Solves pose-bone quaternions for mapped bones of one rig, batched over frames."""
+
+    def __init__(self, skeleton: Skeleton, rig: TargetRig, mapping: dict[str, str], *, root_mode: str = "xyz",
+                 root_scale: float | None = None):
+        if root_mode not in ROOT_MODES:
+            raise ValueError(f"root mode must be one of {ROOT_MODES}, got {root_mode!r}")
+        self.skeleton, self.rig, self.root_mode = skeleton, rig, root_mode
+        self.mapped = resolve_mapping(skeleton, rig, mapping)
+        if not self.mapped:
+            raise ValueError(f"no bone of armature {rig.name!r} is mapped to a {skeleton.name} joint: "
+                             "wrong armature or preset?")
+        self.bone_indices = np.array([m.index for m in self.mapped])
+        self.bone_names = tuple(m.bone for m in self.mapped)
+        roots = [m for m in self.mapped if m.is_root]
+        self.root = roots[0] if roots else None
+        self.arm_from_kinect = rig.object_rotation.T @ KINECT_TO_BLENDER
+        # the character's own left and up in armature space, for hints when a joint is missing
+        self.world_lateral = rig.object_rotation.T @ np.array([1.0, 0.0, 0.0])
+        self.world_up = rig.object_rotation.T @ np.array([0.0, 0.0, 1.0])
+        tpos = target_joint_positions(skeleton, rig, self.mapped)
+        get_t = _drop_unknown(resolver(skeleton.joints, tpos))
+        self.target_leg = leg_length(get_t)
+        # constant per bone: C_b = O_tᵀ · R_rest(b)
+        self.constants = np.empty((len(self.mapped), 3, 3))
+        for k, m in enumerate(self.mapped):
+            y = rig.rest[m.index, :3, 1]
+            hint = segment_hint(get_t, m.tail_name, y, self.world_lateral, self.world_up)
+            o_t = frame_from_y_hint(y, np.nan_to_num(hint))
+            self.constants[k] = o_t.T @ rig.rest[m.index, :3, :3]
+        self._plan = self._chain_plan()
+        self.root_scale = root_scale
+
+    def _chain_plan(self) -> list[tuple[int, int, np.ndarray, int | None, bool]]:
+        """Bones to evaluate in order: (bone, parent, R_rel, mapped slot or None, inherit_rotation)."""
+        rig = self.rig
+        slot = {m.index: k for k, m in enumerate(self.mapped)}
+        needed = set(slot)
+        for b in list(slot):
+            needed.update(rig.ancestors(b))
+        plan = []
+        for b in _topological(rig):
+            if b not in needed:
+                continue
+            p = int(rig.parents[b])
+            rel = rig.rest[b, :3, :3] if p < 0 else rig.rest[p, :3, :3].T @ rig.rest[b, :3, :3]
+            plan.append((b, p, rel, slot.get(b), bool(rig.inherit_rotation[b])))
+        return plan
+
+    def scale_for(self, source_leg: float | None) -> float:
+        """Root scale n (eq. 13): target leg / source leg, unless fixed."""
+        if self.root_scale is not None:
+            return float(self.root_scale)
+        if self.rig.generated or not source_leg or not self.target_leg:
+            return 1.0
+        return self.target_leg / source_leg
+
+    def solve(self, positions: np.ndarray, root_reference: np.ndarray | None = None,
+              source_leg: float | None = None, want_desired: bool = False):
+        """positions (F, J, 3) Kinect camera space -> quats (F, M, 4) for self.bone_names, and the root bone's
+        pose location (F, 3) (zeros without a mapped root). root_reference: Kinect position of the root joint
+        that maps to the rest position (the take's first keyed frame). With want_desired, also the desired
+        armature-space bone rotations (F, M, 3, 3), for rigs whose constraints need Blender's evaluation."""
+        p = np.asarray(positions, dtype=np.float64) @ self.arm_from_kinect.T
+        nframes = p.shape[0]
+        get = resolver(self.skeleton.joints, p)
+        desired = np.empty((nframes, len(self.mapped), 3, 3))
+        for k, m in enumerate(self.mapped):
+            y = p[:, m.tail] - p[:, m.head]
+            o_s = frame_from_y_hint(y, segment_hint(get, m.tail_name, y, self.world_lateral, self.world_up))
+            desired[:, k] = o_s @ self.constants[k]
+        posed: dict[int, np.ndarray] = {}
+        basis = np.empty_like(desired)
+        for b, parent, rel, k, inherit in self._plan:
+            parent_rot = posed[parent] @ rel if parent >= 0 else rel
+            if k is None:
+                posed[b] = parent_rot
+                continue
+            posed[b] = desired[:, k]
+            frame_rot = parent_rot if inherit else self.rig.rest[b, :3, :3]
+            basis[:, k] = np.swapaxes(frame_rot, -1, -2) @ desired[:, k]
+        quats = from_matrix(basis)
+        location = np.zeros((nframes, 3))
+        if self.root is not None and self.root_mode != "none" and nframes:
+            ref = p[0, self.root.head] if root_reference is None else root_reference @ self.arm_from_kinect.T
+            delta = (p[:, self.root.head] - ref) * self.scale_for(source_leg)
+            if self.root_mode == "xy":
+                delta -= np.outer(delta @ self.world_up, self.world_up)
+            b = self.root.index
+            parent = int(self.rig.parents[b])
+            rel = self._plan_rel(b)
+            frame_rot = posed[parent] @ rel if parent >= 0 else rel
+            location = np.einsum("...ji,...j->...i", np.broadcast_to(frame_rot, (nframes, 3, 3)), delta)
+        return (quats, location, desired) if want_desired else (quats, location)
+
+    def _plan_rel(self, b: int) -> np.ndarray:
+        for bone, _, rel, _, _ in self._plan:
+            if bone == b:
+                return rel
+        raise KeyError(b)
+
+
+def _drop_unknown(get):
+    """Wrap a joint lookup so joints with NaN positions count as absent."""
+    def inner(name):
+        v = get(name)
+        return None if v is None or np.isnan(v).any() else v
+    return inner
