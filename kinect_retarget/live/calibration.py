@@ -11,6 +11,8 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from ..core.joint_frames import resolver
+from ..core.retarget import leg_length
 from ..core.skeletons import NOT_TRACKED, SKELETONS, Skeleton
 
 MIN_FRAMES = 10
@@ -70,13 +72,9 @@ def calibrate(skeleton: Skeleton, positions: np.ndarray, states: np.ndarray,
     med = np.nanmedian(p, axis=0)  # (J, 3) the standing pose, robust to single bad frames
     bone = {skeleton.joints[j]: float(np.linalg.norm(med[j] - med[par]))
             for j, par in enumerate(skeleton.parents) if par >= 0 and np.all(np.isfinite(med[[j, par]]))}
-    leg = []
-    for s in ("Left", "Right"):
-        if all(f"{x}{s}" in bone for x in ("Knee", "Ankle")):
-            leg.append(bone[f"Knee{s}"] + bone[f"Ankle{s}"])
-    if not leg or min(leg) <= 0.2:
+    source_leg = leg_length(resolver(skeleton.joints, p))  # the engine's own measure, so n matches a bake
+    if source_leg is None or not source_leg > 0.2:
         raise CalibrationError("leg length could not be measured (are the knees and ankles tracked?)")
-    source_leg = float(np.mean(leg))
     if generated_rig or not target_leg:
         scale = 1.0
     else:

@@ -25,10 +25,13 @@ class Recorder:
     def frames(self) -> int:
         return self._writer.frames
 
-    def write(self, session_time: float, positions: np.ndarray, states: np.ndarray) -> None:
-        t = max(session_time - self.start_time, self._last + 1e-6)  # equal arrival stamps would break a Take
+    def write(self, session_time: float, positions: np.ndarray, states: np.ndarray) -> float:
+        """Returns the time exactly as stored (microseconds), which the live pipeline then uses too, so
+        time-dependent filters see the same steps live and in the bake."""
+        t = round(max(session_time - self.start_time, self._last + 1e-6), 6)  # a Take needs rising times
         self._writer.write(t, positions, states)
         self._last = t
+        return t
 
     def close(self) -> None:
         self._writer.close()

@@ -44,15 +44,22 @@ class LiveSession:
         self._t0_source: float | None = None   # source clock of the first frame
         self._t0_session = 0.0                 # session clock of the first frame
         self._last_tracked_time: float | None = None
+        self._pipe_offset = 0.0  # pipeline clock = session clock - offset (the recording's, once one started)
         self._calibration: tuple[CalibrationCapture, Callable] | None = None
 
     # -- lifecycle -------------------------------------------------------------------------------------
     def start(self) -> None:
         self.start_clock = self.clock()
-        if hasattr(self.pipeline, "reset"):
-            self.pipeline.reset()
+        self._reset_pipeline()
         self.source.start(self.queue)  # SourceError propagates: nothing was started
         self.running = True
+
+    def _reset_pipeline(self) -> None:
+        if hasattr(self.pipeline, "reset"):
+            try:
+                self.pipeline.reset(self.source.rate)
+            except TypeError:
+                self.pipeline.reset()
 
     def now(self) -> float:
         """Seconds since start on the session clock."""
@@ -62,6 +69,10 @@ class LiveSession:
         if self.recorder is not None:
             raise LiveError(f"already recording to {self.recorder.path}")
         self.recorder = Recorder(path, self.source.skeleton, self.source.rate, self.now(), metadata)
+        self._pipe_offset = self.recorder.start_time
+        # The bake replays the recording from a fresh pipeline: restart filters and the root reference
+        # here too, so what was seen live is exactly what gets keyed.
+        self._reset_pipeline()
         return self.recorder
 
     def stop_recording(self) -> str | None:
@@ -99,11 +110,13 @@ class LiveSession:
         for frame in frames:
             self.stats.received += 1
             self.stats.rate.add(frame.arrival)
-            t = self._session_time(frame)
+            ts = self._session_time(frame)
             if self.recorder is not None:
-                self.recorder.write(t, frame.positions, frame.states)
+                t = self.recorder.write(ts, frame.positions, frame.states)  # exactly the stored time
                 self.stats.recorded += 1
-            if self._calibration is not None and self._calibration[0].add(t, frame.positions, frame.states):
+            else:
+                t = ts - self._pipe_offset
+            if self._calibration is not None and self._calibration[0].add(ts, frame.positions, frame.states):
                 capture, done = self._calibration
                 self._calibration = None
                 done(capture)
@@ -115,10 +128,10 @@ class LiveSession:
             tracked = int(np.count_nonzero(frame.states != NOT_TRACKED))
             if pose is None or tracked == 0:
                 self.stats.untracked += 1
-                if self._lost_tracking(t):
+                if self._lost_tracking(ts):
                     return False
                 continue
-            self._last_tracked_time = t
+            self._last_tracked_time = ts
             self.last_tracked_joints = tracked
             if newest is not None:
                 self.stats.superseded += 1
