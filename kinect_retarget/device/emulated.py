@@ -1,0 +1,420 @@
+"""An emulated Kinect v1, as a pyusb backend (usb.backend.IBackend).
+
+It enumerates the camera (and, for the 1414, the motor; for the 1473 and Kinect for Windows, the audio
+bootloader) with real descriptors, answers the GM/RB command protocol with register state, stalls on
+malformed commands as the device's control pipe would, drives a tilt motor with an accelerometer, and
+streams depth built from a sequence of depth images through the iso seam (emulated_stream.py), with fault
+injection. The driver runs unchanged against it: only the iso seam has an emulated implementation.
+"""
+from __future__ import annotations
+
+import array
+import errno
+import itertools
+import math
+import struct
+import threading
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import usb.backend
+from usb.core import USBError
+
+from . import protocol as P
+from .protocol import TICKS_PER_FRAME
+from .emulated_stream import DepthPacketizer, EmulatedIsoPump, Faults, VirtualClock
+
+LIBUSB_ERROR_PIPE = -9
+LIBUSB_ERROR_NO_DEVICE = -4
+LIBUSB_ERROR_ACCESS = -3
+DEFAULT_SERIAL = "A00366A08793039A"
+CONST_SHIFT = 200
+FIXED_PARAMS = (7.5, 2.4, 120.0, 0.1052)       # emitter dist (cm), rcmos dist (cm), ref dist (mm), pixel (mm)
+MOTOR_DEG_PER_S = 15.0                          # emulated slew rate
+COUNTS_PER_G = 819
+
+
+class _Desc:
+    def __init__(self, **fields):
+        self.__dict__.update(fields)
+
+
+def _endpoint(address: int, max_packet: int) -> _Desc:
+    return _Desc(bLength=7, bDescriptorType=5, bEndpointAddress=address, bmAttributes=0x01,
+                 wMaxPacketSize=max_packet, bInterval=1, bRefresh=0, bSynchAddress=0, extra_descriptors=[])
+
+
+def _interface(number: int, alt: int, endpoints: list, cls: int = 0xFF) -> _Desc:
+    return _Desc(bLength=9, bDescriptorType=4, bInterfaceNumber=number, bAlternateSetting=alt,
+                 bNumEndpoints=len(endpoints), bInterfaceClass=cls, bInterfaceSubClass=0xFF,
+                 bInterfaceProtocol=0xFF, iInterface=0, extra_descriptors=[], endpoints=endpoints)
+
+
+@dataclass
+class _UsbFunction:
+    """One USB device of the Kinect (camera, motor or audio)."""
+    kind: str
+    product_id: int
+    bcd_device: int
+    product: str
+    serial: str | None
+    interfaces: list            # [interface number][alt setting] -> _Desc
+    port_numbers: tuple
+    address: int = 0
+
+    def device_descriptor(self, bus: int) -> _Desc:
+        return _Desc(bLength=18, bDescriptorType=1, bcdUSB=0x0200, bDeviceClass=0, bDeviceSubClass=0,
+                     bDeviceProtocol=0, bMaxPacketSize0=64, idVendor=P.VENDOR_MICROSOFT,
+                     idProduct=self.product_id, bcdDevice=self.bcd_device, iManufacturer=1, iProduct=2,
+                     iSerialNumber=3 if self.serial else 0, bNumConfigurations=1, address=self.address,
+                     bus=bus, port_number=self.port_numbers[-1], port_numbers=self.port_numbers, speed=3)
+
+    def strings(self) -> dict[int, str]:
+        return {1: "Microsoft", 2: self.product, 3: self.serial or ""}
+
+
+@dataclass
+class _Handle:
+    function: _UsbFunction
+    generation: int
+    claimed: set = field(default_factory=set)
+    alt: dict = field(default_factory=dict)
+
+
+@dataclass
+class _DepthStreamState:
+    id: int
+    start_time: float
+    packetizer: DepthPacketizer
+
+
+class EmulatedKinect(usb.backend.IBackend):
+    """A pyusb backend holding one emulated Kinect.
+
+    images: sequence of (480, 640) raw 11-bit depth images the depth stream cycles through.
+    model: "1414", "1473" or "k4w". clock/sleep: time source (time.monotonic/time.sleep, or a
+    VirtualClock to run faster than real time).
+    """
+
+    def __init__(self, images, model: str = "1414", serial: str = DEFAULT_SERIAL, faults: Faults | None = None,
+                 clock=None, sleep=None, bus: int = 1):
+        super().__init__()
+        self.images = [np.asarray(img, dtype=np.uint16) for img in images]
+        if not self.images:
+            raise ValueError("the emulated Kinect needs at least one depth image")
+        self.model = model
+        self.faults = faults or Faults()
+        if isinstance(clock, VirtualClock) and sleep is None:
+            sleep = clock.sleep
+        self.clock = clock or time.monotonic
+        self.sleep = sleep or time.sleep
+        self.bus = bus
+        self._lock = threading.RLock()
+        self._generation = 0
+        self._addresses = itertools.count(5)
+        self._stream_ids = itertools.count(1)
+        self._first_start: float | None = None
+        self._manual_plugged = True
+        self.functions = self._build_functions(model, serial)
+        self._assign_addresses()
+        self._power_on()
+        self.depth_starts = 0                   # how many times the depth stream was started
+        self.streams: list[DepthPacketizer] = []
+
+    def expected_frame(self, timestamp: int) -> tuple[int, int]:
+        """(stream number, frame number in that stream) that a delivered frame's timestamp belongs to."""
+        for n, packetizer in enumerate(self.streams):
+            offset = (timestamp - packetizer.first_timestamp) & 0xFFFFFFFF
+            if offset % TICKS_PER_FRAME == 0:
+                return n, offset // TICKS_PER_FRAME
+        raise KeyError(f"timestamp {timestamp} belongs to no emulated stream")
+
+    def expected_raw(self, timestamp: int) -> np.ndarray:
+        """The depth image the emulated device sent with this timestamp."""
+        _, frame = self.expected_frame(timestamp)
+        return self.images[frame % len(self.images)]
+
+    # --- topology ----------------------------------------------------------------------------------------
+    @staticmethod
+    def _build_functions(model: str, serial: str) -> list[_UsbFunction]:
+        iso = P.MAX_ISO_PACKET_SIZE // 2 | (1 << 11)             # 960 bytes x 2 transactions per microframe
+        camera_alt0 = _interface(0, 0, [_endpoint(P.VIDEO_ENDPOINT, iso), _endpoint(P.DEPTH_ENDPOINT, iso)])
+        if model == "1414":
+            camera = _UsbFunction("camera", P.PID_CAMERA, P.BCD_MODEL_1414, "Xbox NUI Camera", serial,
+                                  [[camera_alt0]], (1, 1))
+            motor = _UsbFunction("motor", P.PID_MOTOR, 0x0107, "Xbox NUI Motor", None,
+                                 [[_interface(0, 0, [])]], (1, 2))
+            return [motor, camera]
+        if model not in ("1473", "k4w"):
+            raise ValueError(f"unknown Kinect model {model!r}: use '1414', '1473' or 'k4w'")
+        if model == "1473":
+            camera = _UsbFunction("camera", P.PID_CAMERA, 0x0110, "Xbox NUI Camera", "0000000000000000",
+                                  [[camera_alt0]], (1, 1))
+            audio_pid = P.PID_AUDIO
+        else:   # Kinect for Windows: alt setting 0 has zero-bandwidth endpoints, alt 1 streams
+            alt0 = _interface(0, 0, [_endpoint(P.VIDEO_ENDPOINT, 0), _endpoint(P.DEPTH_ENDPOINT, 0)])
+            alt1 = _interface(0, 1, [_endpoint(P.VIDEO_ENDPOINT, iso), _endpoint(P.DEPTH_ENDPOINT, iso)])
+            camera = _UsbFunction("camera", P.PID_CAMERA_K4W, 0x0100, "Kinect for Windows Camera",
+                                  "0000000000000000", [[alt0, alt1]], (1, 1))
+            audio_pid = P.PID_AUDIO_K4W
+        # Audio chip in its bootloader: one interface; motor/LED need the proprietary audio firmware.
+        audio = _UsbFunction("audio", audio_pid, 0x0100, "Xbox Kinect Audio", serial,
+                             [[_interface(0, 0, [_endpoint(0x81, 512), _endpoint(0x01, 512)])]], (1, 3))
+        return [camera, audio]
+
+    def _assign_addresses(self) -> None:
+        for fn in self.functions:
+            fn.address = next(self._addresses)
+
+    def _power_on(self) -> None:
+        self.registers: dict[int, int] = {}
+        self.depth_stream: _DepthStreamState | None = None
+        self._pending_reply: bytes | None = None
+        self._reply_delay = 0
+        self.led = 1
+        self.tilt_deg = 0.0
+        self._tilt_target = 0.0
+        self._tilt_since = self.clock()
+
+    # --- plug state --------------------------------------------------------------------------------------
+    def _scheduled_plugged(self) -> bool:
+        f = self.faults
+        if self._first_start is None or f.unplug_at is None:
+            return True
+        t = self.clock() - self._first_start
+        return not (t >= f.unplug_at and (f.replug_at is None or t < f.replug_at))
+
+    @property
+    def plugged(self) -> bool:
+        return self._manual_plugged and self._scheduled_plugged()
+
+    def unplug(self) -> None:
+        with self._lock:
+            self._manual_plugged = False
+            self._update_plug()
+
+    def replug(self) -> None:
+        with self._lock:
+            self._manual_plugged = True
+            self._update_plug()
+
+    def _update_plug(self) -> None:
+        """Apply a plug change: unplugging invalidates every handle and resets the device on power-up."""
+        plugged = self.plugged
+        if not plugged and self._generation >= 0:
+            self._generation = -(self._generation + 1)       # negative: unplugged
+        elif plugged and self._generation < 0:
+            self._generation = -self._generation
+            self._assign_addresses()
+            self._power_on()
+
+    def check_handle(self, handle: _Handle) -> None:
+        with self._lock:
+            self._update_plug()
+            if handle.generation != self._generation:
+                raise USBError("No such device (it may have been disconnected)", errno.ENODEV,
+                               LIBUSB_ERROR_NO_DEVICE)
+
+    # --- IBackend: enumeration and descriptors -----------------------------------------------------------
+    def enumerate_devices(self):
+        with self._lock:
+            self._update_plug()
+            return list(self.functions) if self._generation >= 0 else []
+
+    def get_device_descriptor(self, dev):
+        return dev.device_descriptor(self.bus)
+
+    def get_configuration_descriptor(self, dev, config):
+        if config != 0:
+            raise IndexError(config)
+        return _Desc(bLength=9, bDescriptorType=2, wTotalLength=0, bNumInterfaces=len(dev.interfaces),
+                     bConfigurationValue=1, iConfiguration=0, bmAttributes=0x80, bMaxPower=250,
+                     extra_descriptors=[])
+
+    def get_interface_descriptor(self, dev, intf, alt, config):
+        return dev.interfaces[intf][alt]          # IndexError past the last alt setting, as pyusb expects
+
+    def get_endpoint_descriptor(self, dev, ep, intf, alt, config):
+        return dev.interfaces[intf][alt].endpoints[ep]
+
+    # --- IBackend: handles ----------------------------------------------------------------------------------
+    def open_device(self, dev):
+        with self._lock:
+            self._update_plug()
+            if self._generation < 0 or dev not in self.functions:
+                raise USBError("No such device (it may have been disconnected)", errno.ENODEV,
+                               LIBUSB_ERROR_NO_DEVICE)
+            if self.faults.access_denied:
+                raise USBError("Access denied (insufficient permissions)", errno.EACCES, LIBUSB_ERROR_ACCESS)
+            return _Handle(dev, self._generation)
+
+    def close_device(self, dev_handle):
+        pass
+
+    def set_configuration(self, dev_handle, config_value):
+        self.check_handle(dev_handle)
+
+    def get_configuration(self, dev_handle):
+        self.check_handle(dev_handle)
+        return 1
+
+    def set_interface_altsetting(self, dev_handle, intf, altsetting):
+        self.check_handle(dev_handle)
+        if altsetting >= len(dev_handle.function.interfaces[intf]):
+            raise USBError("Pipe error", errno.EPIPE, LIBUSB_ERROR_PIPE)
+        dev_handle.alt[intf] = altsetting
+
+    def claim_interface(self, dev_handle, intf):
+        self.check_handle(dev_handle)
+        dev_handle.claimed.add(intf)
+
+    def release_interface(self, dev_handle, intf):
+        dev_handle.claimed.discard(intf)
+
+    def is_kernel_driver_active(self, dev_handle, intf):
+        self.check_handle(dev_handle)
+        return False
+
+    def detach_kernel_driver(self, dev_handle, intf):
+        self.check_handle(dev_handle)
+
+    def attach_kernel_driver(self, dev_handle, intf):
+        self.check_handle(dev_handle)
+
+    # --- IBackend: control transfers ------------------------------------------------------------------------
+    def ctrl_transfer(self, dev_handle, bmRequestType, bRequest, wValue, wIndex, data, timeout):
+        with self._lock:
+            self.check_handle(dev_handle)
+            fn = dev_handle.function
+            if bmRequestType == 0x80 and bRequest == 6 and (wValue >> 8) == 3:
+                return self._string_descriptor(fn, wValue & 0xFF, data)
+            if fn.kind == "camera":
+                return self._camera_control(bmRequestType, bRequest, wValue, wIndex, data)
+            if fn.kind == "motor":
+                return self._motor_control(bmRequestType, bRequest, wValue, data)
+            raise USBError("Pipe error", errno.EPIPE, LIBUSB_ERROR_PIPE)
+
+    @staticmethod
+    def _fill(data, payload: bytes) -> int:
+        n = min(len(payload), len(data))
+        data[:n] = array.array("B", payload[:n])
+        return n
+
+    def _string_descriptor(self, fn: _UsbFunction, index: int, data) -> int:
+        if index == 0:
+            return self._fill(data, bytes([4, 3, 0x09, 0x04]))
+        text = fn.strings().get(index)
+        if not text:
+            raise USBError("Pipe error", errno.EPIPE, LIBUSB_ERROR_PIPE)
+        body = text.encode("utf-16-le")
+        return self._fill(data, bytes([2 + len(body), 3]) + body)
+
+    def _stall(self):
+        raise USBError("Pipe error", errno.EPIPE, LIBUSB_ERROR_PIPE)
+
+    def _camera_control(self, rtype, request, value, index, data) -> int:
+        if rtype == P.CMD_REQUEST_OUT and request == 0 and value == 0 and index == 0:
+            self._camera_command(bytes(data))
+            return len(data)
+        if rtype == P.CMD_REQUEST_IN and request == 0 and value == 0 and index == 0:
+            if self._pending_reply is None or self._reply_delay > 0:
+                self._reply_delay -= 1
+                return 0                       # not ready yet: the host polls again
+            reply, self._pending_reply = self._pending_reply, None
+            return self._fill(data, reply)
+        self._stall()
+
+    def _camera_command(self, message: bytes) -> None:
+        """Execute one GM command; malformed commands stall the pipe and leave no reply."""
+        if len(message) < P.HEADER_SIZE or len(message) % 2:
+            self._stall()
+        hdr = P.parse_header(message)
+        payload = message[P.HEADER_SIZE:]
+        if hdr.magic != P.MAGIC_COMMAND or hdr.words * 2 != len(payload):
+            self._stall()
+        args = struct.unpack(f"<{len(payload) // 2}H", payload)
+        reply = self._execute(hdr.opcode, args)
+        if reply is None:
+            self._stall()
+        self._pending_reply = P._HEADER.pack(P.MAGIC_REPLY, len(reply) // 2, hdr.opcode, hdr.tag) + reply
+        self._reply_delay = 1
+
+    def _execute(self, opcode: int, args: tuple) -> bytes | None:
+        if opcode == P.OP_READ_REGISTER and len(args) == 1:
+            return P.words(args[0], self.registers.get(args[0], 0))
+        if opcode == P.OP_WRITE_REGISTER and len(args) == 2:
+            self._write_register(*args)
+            return P.words(0)
+        if opcode == P.OP_FIXED_PARAMS and len(args) == 5:
+            size = 322 if self.model == "1414" else 334
+            body = bytearray(size)
+            struct.pack_into("<4f", body, 94, *FIXED_PARAMS)
+            return bytes(body)
+        if opcode == P.OP_ALGORITHM_PARAMS and len(args) == 5:
+            sizes = {P.ALGO_CONST_SHIFT: 4, 0x40: 118, 0x41: 8}
+            if args[0] not in sizes:
+                return None
+            body = bytearray(sizes[args[0]])
+            if args[0] == P.ALGO_CONST_SHIFT:
+                struct.pack_into("<H", body, 2, CONST_SHIFT)
+            return bytes(body)
+        return None
+
+    def _write_register(self, reg: int, value: int) -> None:
+        self.registers[reg] = value
+        if reg != P.REG_DEPTH_STREAM:
+            return
+        if value == 0:
+            self.depth_stream = None
+            return
+        ready = (self.registers.get(P.REG_DEPTH_FORMAT) == 3 and self.registers.get(P.REG_DEPTH_RESOLUTION) == 1
+                 and self.registers.get(P.REG_DEPTH_FPS) == 30)
+        if value == 2 and ready:
+            now = self.clock()
+            if self._first_start is None:
+                self._first_start = now
+            sid = next(self._stream_ids)
+            seq0 = (sid * 97) & 0xFF                     # streams do not restart at sequence 0
+            packetizer = DepthPacketizer(self.images, seq0, sid * 12_345_678)
+            self.depth_stream = _DepthStreamState(sid, now, packetizer)
+            self.streams.append(packetizer)
+            self.depth_starts += 1
+
+    def _motor_control(self, rtype, request, value, data) -> int:
+        self._advance_motor()
+        if rtype == 0x40 and request == 0x31:
+            angle = struct.unpack("<h", struct.pack("<H", value & 0xFFFF))[0] / 2.0
+            self._tilt_target = max(-27.0, min(27.0, angle))
+            return 0
+        if rtype == 0x40 and request == 0x06:
+            if value not in (0, 1, 2, 3, 4, 5, 6):
+                self._stall()
+            self.led = value
+            return 0
+        if rtype == 0xC0 and request == 0x32:
+            return self._fill(data, self._motor_state())
+        if rtype == 0xC0 and request == 0x10:
+            return self._fill(data, b"\x22")
+        self._stall()
+
+    def _advance_motor(self) -> None:
+        now = self.clock()
+        step = MOTOR_DEG_PER_S * (now - self._tilt_since)
+        self._tilt_since = now
+        d = self._tilt_target - self.tilt_deg
+        self.tilt_deg = self._tilt_target if abs(d) <= step else self.tilt_deg + math.copysign(step, d)
+
+    def _motor_state(self) -> bytes:
+        theta = math.radians(self.tilt_deg)
+        ax, ay, az = 0, round(COUNTS_PER_G * math.cos(theta)), round(COUNTS_PER_G * math.sin(theta))
+        moving = self.tilt_deg != self._tilt_target
+        status = 4 if moving else (1 if abs(self.tilt_deg) >= 27.0 else 0)
+        return struct.pack(">2xhhhbB", ax, ay, az, round(self.tilt_deg * 2), status)
+
+    # --- the iso seam -------------------------------------------------------------------------------------
+    def open_iso_pump(self, dev_handle, endpoint: int, transfers: int, packets_per_transfer: int):
+        self.check_handle(dev_handle)
+        if endpoint != P.DEPTH_ENDPOINT:
+            raise USBError("Pipe error", errno.EPIPE, LIBUSB_ERROR_PIPE)
+        return EmulatedIsoPump(self, dev_handle, endpoint, transfers, packets_per_transfer)

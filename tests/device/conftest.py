@@ -1,0 +1,14 @@
+"""Fixtures for the device tests: real Kinect v1 depth frames from the shared data."""
+from __future__ import annotations
+
+import pytest
+
+from kinect_retarget.device.depth_images import load_fakenect_dir
+
+FAKENECT = "depth_real/fakenect_openiss/fakenect-record"
+
+
+@pytest.fixture(scope="session")
+def real_depth(shared_data):
+    """Ten consecutive real raw 11-bit depth frames (480, 640) uint16 recorded by libfreenect."""
+    return load_fakenect_dir(shared_data / FAKENECT, limit=10)
