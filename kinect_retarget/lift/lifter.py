@@ -1,0 +1,216 @@
+"""2D joint tracks -> a 3D take (paper 004 §3.2, with the extensions described in docs/lifting.md).
+
+1. short gaps filled in 2D; 2. per-frame scale (scale.py); 3. each bone's depth magnitude
+dz = sqrt(L^2 - d^2 / s^2); 4. the depth signs over the whole take (signs.py); 5. joints placed along the
+tree from the pelvis: on the joint's image ray (perspective, when the focal length is known) or on its
+orthographic line, at the bone's length from its parent; joints never seen are placed by a default
+direction and marked inferred.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED, topological_order
+from ..core.take import Take, nominal_rate
+from .bones import DEFAULT_HEIGHT_M, lengths_from_height
+from .camera import Camera
+from .gaps import fill_gaps
+from .scale import SCALE_BONES, fill_missing, smooth_lengths, scale_envelope, scale_lower_bound, scale_paper
+from .smoothing import gaussian_smooth
+from .signs import SignPriors, choose_signs
+from .tracks2d import LiftError, Tracks2D
+
+SK = KINECT_V1
+PARENTS = SK.parent_array
+# Parents before children, shallow joints first (both hips are placed before any foot needs "forward").
+
+
+def _shallow_first_order() -> np.ndarray:
+    depth = np.zeros(len(SK), dtype=np.int64)
+    for j in topological_order(SK)[1:]:
+        depth[j] = depth[PARENTS[j]] + 1
+    return np.argsort(depth, kind="stable")
+
+
+ORDER = _shallow_first_order()
+
+
+@dataclass
+class LiftSettings:
+    """height_m sets anthropometric bone lengths unless `lengths` (J,) are given (calibrated, metres).
+    focal_px: the camera's focal length in pixels; None means unknown (scaled orthographic model).
+    image_size: (W, H) overriding the tracks' own. scale: "envelope" or "paper" (eq. 3). signs: "viterbi",
+    "greedy" or "camera" (signs.py). max_gap_s: longest 2D gap filled by interpolation."""
+
+    height_m: float = DEFAULT_HEIGHT_M
+    lengths: np.ndarray | None = None
+    focal_px: float | None = None
+    image_size: tuple[float, float] | None = None
+    scale: str = "envelope"
+    scale_window_s: float = 1.0
+    scale_quantile: float = 0.9
+    signs: str = "viterbi"
+    priors: SignPriors = field(default_factory=SignPriors)
+    max_gap_s: float = 0.5
+    smooth_2d_s: float = 0.05
+    smooth_depth_s: float = 0.08
+    min_confidence: float = 0.05
+
+
+@dataclass
+class LiftResult:
+    take: Take
+    scale: np.ndarray          # (F,) pixels per metre
+    signs: np.ndarray          # (F, J) depth sign of each bone (by child joint)
+    camera: Camera
+    problems: list[str]
+
+
+def lift(tracks: Tracks2D, settings: LiftSettings | None = None) -> LiftResult:
+    st = settings or LiftSettings()
+    problems = list(tracks.problems)
+    lengths = np.asarray(st.lengths, dtype=np.float64) if st.lengths is not None else lengths_from_height(st.height_m)
+    if lengths.shape != (len(SK),) or np.any(lengths[PARENTS >= 0] <= 0):
+        raise LiftError(f"bone lengths must be {len(SK)} positive values (one per joint, root 0)")
+    cam = _camera(tracks, st, problems)
+    present = tracks.confidence >= st.min_confidence
+    uv, filled = fill_gaps(tracks.uv, present, tracks.times, st.max_gap_s)
+    have = present | filled
+    uv = gaussian_smooth(uv, have[..., None], tracks.times, st.smooth_2d_s)
+    body = have[:, SK.root]
+    for i in np.flatnonzero(~body & have.any(axis=1)):
+        problems.append(f"{tracks.source}: {tracks.frame_label(i)}: hips not visible, frame left untracked")
+    measured = present & ~tracks.inferred
+
+    # Orthographic image coordinates in Kinect axes (pixels, relative to the principal point).
+    xy = np.stack([-(uv[..., 0] - cam.cx), -(uv[..., 1] - cam.cy)], axis=-1)
+    bone_ok = have & have[:, np.maximum(PARENTS, 0)] & (PARENTS >= 0)
+    d_vec = xy - xy[:, np.maximum(PARENTS, 0)]
+    d_px = np.linalg.norm(d_vec, axis=-1)
+    scale_idx = np.array([SK.index(n) for n in SCALE_BONES])
+    usable = measured[:, scale_idx] & measured[:, PARENTS[scale_idx]] & body[:, None]
+    s_min = scale_lower_bound(d_px[:, scale_idx], lengths[scale_idx], usable)
+    s_min = fill_missing(s_min, tracks.source or "2D tracks")
+    if st.scale == "paper":
+        s = scale_paper(d_px[:, scale_idx] * usable, lengths[scale_idx], s_min)
+    else:
+        ratios = np.where(usable, smooth_lengths(d_px[:, scale_idx], usable) / lengths[scale_idx], np.nan)
+        s = scale_envelope(ratios, tracks.times, st.scale_window_s, st.scale_quantile)
+    if st.scale not in ("paper", "envelope"):
+        raise LiftError(f"unknown scale method {st.scale!r} (envelope, paper)")
+
+    dxy = np.where(bone_ok[..., None], d_vec / s[:, None, None], 0.0)
+    dz = np.where(bone_ok, np.sqrt(np.maximum(0.0, lengths ** 2 - np.sum(dxy ** 2, axis=-1))), 0.0)
+    travel = _travel_direction(xy[:, SK.root] / s[:, None], cam.focal_px / s, tracks.times, body)
+    signs = choose_signs(dxy, dz, tracks.times, body, travel, st.priors, st.signs)
+
+    positions = _place_joints(uv, have, s, signs, lengths, cam, st.focal_px is not None,
+                              tracks.times, body, st.smooth_depth_s)
+    states = np.where(measured & ~filled, TRACKED, INFERRED).astype(np.uint8)
+    states[~body] = NOT_TRACKED
+    positions[~body] = np.nan
+    rate = nominal_rate(tracks.times)
+    meta = {"lifted_from": tracks.source, "focal_px": cam.focal_px, "focal_known": cam.focal_known,
+            "scale_method": st.scale, "sign_method": st.signs, "problems": len(problems)}
+    take = Take(SK, positions, states, tracks.times, rate, "lift", meta)
+    return LiftResult(take, s, signs, cam, problems)
+
+
+def _camera(tracks: Tracks2D, st: LiftSettings, problems: list[str]) -> Camera:
+    size = st.image_size or tracks.image_size
+    if size is None:
+        ok = tracks.present
+        if not ok.any():
+            raise LiftError(f"{tracks.source}: no joint is visible in any frame")
+        pts = tracks.uv[ok]
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        size = tuple(float(v) for v in (lo + hi))  # centred on the keypoints' bounding box
+        problems.append(f"{tracks.source}: image size unknown; assuming the principal point at the "
+                        f"keypoints' centre ({size[0] / 2:.0f}, {size[1] / 2:.0f}) px (use --image-size)")
+    w, h = float(size[0]), float(size[1])
+    if not (w > 0 and h > 0):
+        raise LiftError(f"image size must be positive, got {w} x {h}")
+    if st.focal_px is not None and not st.focal_px > 0:
+        raise LiftError(f"focal length must be positive, got {st.focal_px}")
+    return Camera.for_image(w, h, st.focal_px)
+
+
+def _travel_direction(root_xy: np.ndarray, root_z: np.ndarray, times: np.ndarray, body: np.ndarray):
+    """(F, 3) horizontal direction of the body's travel, weighted 0..1 by speed (0 when standing)."""
+    f = len(times)
+    if f < 3:
+        return np.zeros((f, 3))
+    p = np.stack([root_xy[:, 0], np.zeros(f), root_z], axis=-1)
+    p[~body] = np.nan
+    idx = np.arange(f)
+    for c in (0, 2):
+        ok = np.isfinite(p[:, c])
+        p[:, c] = np.interp(idx, idx[ok], p[ok, c]) if ok.any() else 0.0
+    w = max(1, int(round(0.5 / float(np.median(np.diff(times))))))
+    kern = np.ones(w) / w
+    sm = np.stack([np.convolve(np.pad(p[:, c], w, mode="edge"), kern, "same")[w:-w] for c in range(3)], -1)
+    v = np.gradient(sm, times, axis=0)
+    speed = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.maximum(speed, 1e-9) * np.clip((speed - 0.2) / 0.5, 0.0, 1.0)
+
+
+# Directions (Kinect axes, facing the camera) for joints never seen: limbs hang, the trunk stands.
+_DOWN, _UP = np.array([0.0, -1.0, 0.0]), np.array([0.0, 1.0, 0.0])
+_DEFAULT_DIR = {name: _DOWN for name in SK.joints}
+_DEFAULT_DIR.update({"Spine": _UP, "ShoulderCenter": _UP, "Head": _UP,
+                     "ShoulderLeft": np.array([-1.0, 0, 0]), "ShoulderRight": np.array([1.0, 0, 0]),
+                     "HipLeft": np.array([-0.9, -0.45, 0]), "HipRight": np.array([0.9, -0.45, 0])})
+
+
+def _place_joints(uv, have, s, signs, lengths, cam: Camera, perspective: bool, times, body,
+                  smooth_s: float) -> np.ndarray:
+    """Walk the tree from the pelvis, putting each joint on its image ray (or orthographic line) at its
+    bone's length from the parent, on the chosen depth side. The bone's signed depth offset is smoothed
+    over time first: near the image plane it is very sensitive to 2D noise."""
+    f = uv.shape[0]
+    pos = np.full((f, len(SK), 3), np.nan)
+    z_root = cam.focal_px / s
+    rays = cam.rays(np.nan_to_num(uv))
+    r = SK.root
+    pos[:, r] = rays[:, r] * z_root[:, None]
+    fwd = None
+    for j in ORDER[1:]:
+        p = PARENTS[j]
+        parent = pos[:, p]
+        if perspective:
+            o, d = np.zeros((f, 3)), rays[:, j]
+        else:  # orthographic: the line through the joint's (X, Y) along the optical axis
+            o = np.concatenate([rays[:, j, :2] * z_root[:, None], np.zeros((f, 1))], axis=1)
+            d = np.tile([0.0, 0.0, 1.0], (f, 1))
+        a = np.sum(d * d, axis=1)
+        b = 2 * np.sum(d * (o - parent), axis=1)
+        c = np.sum((o - parent) ** 2, axis=1) - lengths[j] ** 2
+        t = (-b + signs[:, j] * np.sqrt(np.maximum(b * b - 4 * a * c, 0.0))) / (2 * a)
+        dz = gaussian_smooth(o[:, 2] + t * d[:, 2] - parent[:, 2], have[:, j] & body, times, smooth_s)
+        on_ray = o + ((parent[:, 2] + dz - o[:, 2]) / d[:, 2])[:, None] * d
+        if fwd is None and j in (SK.index("FootLeft"), SK.index("FootRight")):
+            fwd = _forward(pos)
+        default = _default_direction(SK.joints[j], pos, p, fwd)
+        guessed = parent + lengths[j] * default
+        pos[:, j] = np.where(have[:, j, None], on_ray, guessed)
+    return pos
+
+
+def _forward(pos: np.ndarray) -> np.ndarray:
+    left = pos[:, SK.index("HipLeft")] - pos[:, SK.index("HipRight")]
+    fwd = np.cross(left, _UP)
+    return fwd / np.maximum(np.linalg.norm(fwd, axis=1, keepdims=True), 1e-9)
+
+
+def _default_direction(name: str, pos: np.ndarray, parent: int, fwd) -> np.ndarray:
+    if name.startswith("Foot") and fwd is not None:
+        d = 0.94 * fwd - 0.34 * _UP
+    elif name.startswith("Hand"):  # continue the forearm
+        d = pos[:, parent] - pos[:, PARENTS[parent]]
+    else:
+        d = np.broadcast_to(_DEFAULT_DIR[name], pos[:, parent].shape)
+    d = np.nan_to_num(d)
+    n = np.linalg.norm(d, axis=1, keepdims=True)
+    return np.where(n > 1e-9, d / np.maximum(n, 1e-9), _DOWN)

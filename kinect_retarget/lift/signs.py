@@ -1,0 +1,203 @@
+"""Depth-sign disambiguation: which way (toward or away from the camera) each bone points.
+
+Every bone's depth offset is known up to its sign (paper 004 §3.2). Bones that move together share one sign
+bit (the pelvis: left hip forward means right hip back), and the bits form small groups: the torso (pelvis,
+spine, shoulder girdle, head) and each limb (3 bits). A group's state per frame is one of 2^bits sign
+patterns; we choose the whole take's states by dynamic programming (Viterbi) with
+* temporal continuity: joints do not jump in depth between frames (a flip only costs nothing where the bone
+  lies in the image plane, which is where a real crossing happens);
+* joint limits: knees do not bend forward, elbows not backward, hands continue the forearm, feet point
+  forward, shoulders and hips do not twist apart by more than a spine can;
+* priors: the trunk does not lean far backward, a walking body faces where it goes.
+The torso is decided first, with each limb's best cost given each torso pattern folded into it, then each
+limb given the torso.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.skeletons import KINECT_V1, Skeleton
+from .viterbi import viterbi
+
+
+@dataclass(frozen=True)
+class SignGroup:
+    name: str
+    anchor: str
+    bits: tuple[tuple[tuple[str, int], ...], ...]  # per bit: (joint whose bone it signs, multiplier)
+
+    @property
+    def joints(self) -> tuple[str, ...]:
+        return tuple(j for bit in self.bits for j, _ in bit)
+
+
+TORSO = SignGroup("torso", "HipCenter", (
+    (("Spine", 1), ("ShoulderCenter", 1)),
+    (("Head", 1),),
+    (("ShoulderLeft", 1), ("ShoulderRight", -1)),
+    (("HipLeft", 1), ("HipRight", -1)),
+))
+LIMBS = tuple(
+    SignGroup(f"{kind}{side}", anchor.format(side), tuple(((j.format(side), 1),) for j in joints))
+    for side in ("Left", "Right")
+    for kind, anchor, joints in (("arm", "Shoulder{}", ("Elbow{}", "Wrist{}", "Hand{}")),
+                                 ("leg", "Hip{}", ("Knee{}", "Ankle{}", "Foot{}"))))
+
+
+@dataclass(frozen=True)
+class SignPriors:
+    """Weights of the sign costs (dimensionless, comparable to one unit of temporal cost)."""
+
+    max_speed_mps: float = 2.0       # joint depth speed that costs 1/2 per frame
+    min_sigma_m: float = 0.015       # floor of that per-frame depth step (2D noise)
+    jump_cost_cap: float = 4.0       # most a single joint's depth jump can cost in one frame
+    knee_hyperextension: float = 40.0
+    elbow_hyperextension: float = 8.0
+    hand_continues_forearm: float = 2.0
+    foot_forward: float = 12.0
+    wrist_behind_back: float = 4.0
+    shoulder_hip_twist: float = 6.0
+    trunk_lean_back: float = 6.0
+    head_back: float = 2.0
+    face_travel: float = 3.0
+
+
+def _sign_table(nbits: int) -> np.ndarray:
+    states = np.arange(2 ** nbits)
+    return np.where((states[:, None] >> np.arange(nbits)) & 1, -1.0, 1.0)
+
+
+def group_positions(group: SignGroup, dxy: np.ndarray, dz: np.ndarray,
+                    skeleton: Skeleton = KINECT_V1) -> np.ndarray:
+    """(F, S, n, 3) positions of the group's joints relative to its anchor for every sign pattern."""
+    table = _sign_table(len(group.bits))
+    names = group.joints
+    f = dxy.shape[0]
+    out = np.zeros((f, table.shape[0], len(names), 3))
+    for k, bit in enumerate(group.bits):
+        for name, mult in bit:
+            j = skeleton.index(name)
+            i = names.index(name)
+            parent = skeleton.joints[skeleton.parents[j]]
+            base = out[:, :, names.index(parent)] if parent in names else 0.0
+            out[:, :, i, :2] = dxy[:, None, j] + (base[..., :2] if parent in names else 0.0)
+            out[:, :, i, 2] = mult * table[None, :, k] * dz[:, None, j] + (base[..., 2] if parent in names else 0.0)
+    return out
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-9)
+
+
+def _hinge(a: np.ndarray, b: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """Signed sine of the bend from a to b about `axis` (all unit-normalised here)."""
+    return np.sum(np.cross(_unit(a), _unit(b)) * _unit(axis), axis=-1)
+
+
+def _temporal(rel_z: np.ndarray, times: np.ndarray, pri: SignPriors, breaks: np.ndarray) -> np.ndarray:
+    """(F-1, S, S) cost of depth jumps of the group's joints between consecutive frames."""
+    dt = np.diff(times)
+    sigma = np.maximum(pri.max_speed_mps * dt, pri.min_sigma_m)
+    jump = rel_z[1:, None, :, :] - rel_z[:-1, :, None, :]
+    # Capped per joint: a bone whose length or scale is slightly off never reaches zero depth where it
+    # crosses the image plane, and a true crossing must stay affordable.
+    cost = np.sum(np.minimum(jump ** 2 / (2 * sigma[:, None, None, None] ** 2), pri.jump_cost_cap), axis=-1)
+    cost[breaks[1:] | breaks[:-1]] = 0.0
+    return cost
+
+
+def _torso_frame(tp: np.ndarray):
+    """Performer's left (F, S, 3) and horizontal forward (F, S, 3) from torso positions (F, S, 7, 3)."""
+    names = TORSO.joints
+    left = tp[:, :, names.index("HipLeft")] - tp[:, :, names.index("HipRight")]
+    left = _unit(left + 0.5 * (tp[:, :, names.index("ShoulderLeft")] - tp[:, :, names.index("ShoulderRight")]))
+    fwd = np.cross(left, np.array([0.0, 1.0, 0.0]))  # left x up = forward (conventions: -Z faces camera)
+    return left, _unit(fwd)
+
+
+def _torso_unary(tp: np.ndarray, left: np.ndarray, fwd: np.ndarray, travel: np.ndarray,
+                 pri: SignPriors) -> np.ndarray:
+    n = TORSO.joints
+    g = lambda name: tp[:, :, n.index(name)]  # noqa: E731
+    hip_l = _unit(g("HipLeft") - g("HipRight"))
+    sh_l = _unit(g("ShoulderLeft") - g("ShoulderRight"))
+    up = _unit(g("ShoulderCenter"))
+    head = _unit(g("Head") - g("ShoulderCenter"))
+    cost = pri.shoulder_hip_twist * np.maximum(0.0, 0.8 - np.sum(hip_l * sh_l, axis=-1)) ** 2 * 4
+    cost += pri.trunk_lean_back * np.maximum(0.0, -np.sum(up * fwd, axis=-1) - 0.1) ** 2 * 10
+    cost += pri.head_back * np.maximum(0.0, -np.sum(head * fwd, axis=-1) - 0.2) ** 2 * 10
+    cost -= pri.face_travel * np.sum(fwd * travel[:, None, :], axis=-1)
+    return cost
+
+
+def _limb_unary(group: SignGroup, lp: np.ndarray, left: np.ndarray, fwd: np.ndarray,
+                pri: SignPriors) -> np.ndarray:
+    """(F, St, Sl) cost of each limb pattern given each torso pattern's body frame."""
+    a, b, c = (lp[:, None, :, i] for i in range(3))  # joint positions rel. anchor: (F, 1, Sl, 3)
+    upper, lower, tip = a, b - a, c - b
+    left, fwd = left[:, :, None], fwd[:, :, None]
+    if group.name.startswith("leg"):
+        flex = _hinge(upper, lower, left)  # knee flexion bends the shin back: positive about the left axis
+        cost = pri.knee_hyperextension * np.maximum(0.0, -flex - 0.05) ** 2 * 10
+        cost += pri.foot_forward * np.maximum(0.0, 0.2 - np.sum(_unit(tip) * fwd, axis=-1)) ** 2
+    else:
+        flex = _hinge(upper, lower, left)  # elbow flexion brings the forearm forward: negative about left
+        cost = pri.elbow_hyperextension * np.maximum(0.0, flex - 0.3) ** 2 * 10
+        cost += pri.hand_continues_forearm * np.maximum(0.0, -np.sum(_unit(tip) * _unit(lower), axis=-1)) ** 2
+        cost += pri.wrist_behind_back * np.maximum(0.0, -np.sum(b * fwd, axis=-1) - 0.3) ** 2 * 10
+    return cost
+
+
+def choose_signs(dxy: np.ndarray, dz: np.ndarray, times: np.ndarray, valid: np.ndarray,
+                 travel: np.ndarray | None = None, priors: SignPriors = SignPriors(),
+                 method: str = "viterbi", skeleton: Skeleton = KINECT_V1) -> np.ndarray:
+    """Depth sign (+1 away from the camera, -1 toward it) of every bone: (F, J), indexed by child joint.
+
+    dxy (F, J, 2) in-plane bone offsets (metres, Kinect X/Y); dz (F, J) their depth magnitudes; valid (F,)
+    frames with a body; travel (F, 3) horizontal unit-ish direction the body moves (0 when still).
+    method: "viterbi" (whole take), "greedy" (frame by frame, causal: usable live), "camera" (every bone
+    toward the camera: no disambiguation, the baseline).
+    """
+    f = dxy.shape[0]
+    signs = np.ones((f, len(skeleton)))
+    if method == "camera":
+        return -signs
+    breaks = ~np.asarray(valid, dtype=bool)
+    travel = np.zeros((f, 3)) if travel is None else travel
+    dxy = np.nan_to_num(dxy)
+    dz = np.nan_to_num(dz)
+    tp = group_positions(TORSO, dxy, dz, skeleton)
+    left, fwd = _torso_frame(tp)
+    limb_pos = [group_positions(g, dxy, dz, skeleton) for g in LIMBS]
+    limb_un = [_limb_unary(g, lp, left, fwd, priors) for g, lp in zip(LIMBS, limb_pos)]
+    unary = _torso_unary(tp, left, fwd, travel, priors) + sum(u.min(axis=2) for u in limb_un)
+    unary[breaks] = 0.0
+    torso_state = _solve(unary, _temporal(tp[..., 2], times, priors, breaks), method)
+    _write(signs, TORSO, torso_state, skeleton)
+    rows = np.arange(f)
+    for g, lp, lu in zip(LIMBS, limb_pos, limb_un):
+        u = lu[rows, torso_state]
+        u[breaks] = 0.0
+        _write(signs, g, _solve(u, _temporal(lp[..., 2], times, priors, breaks), method), skeleton)
+    return signs
+
+
+def _solve(unary: np.ndarray, pairwise: np.ndarray, method: str) -> np.ndarray:
+    if method == "viterbi":
+        return viterbi(unary, pairwise)
+    if method == "greedy":
+        out = np.empty(unary.shape[0], dtype=np.int64)
+        out[0] = int(np.argmin(unary[0]))
+        for t in range(1, unary.shape[0]):  # causal: each frame given the previous choice only
+            out[t] = int(np.argmin(unary[t] + pairwise[t - 1, out[t - 1]]))
+        return out
+    raise ValueError(f"unknown sign method {method!r} (viterbi, greedy, camera)")
+
+
+def _write(signs: np.ndarray, group: SignGroup, states: np.ndarray, skeleton: Skeleton) -> None:
+    table = _sign_table(len(group.bits))[states]
+    for k, bit in enumerate(group.bits):
+        for name, mult in bit:
+            signs[:, skeleton.index(name)] = mult * table[:, k]
