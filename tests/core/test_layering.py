@@ -1,0 +1,37 @@
+"""Nothing outside kinect_retarget/blender/ imports Blender modules; the package imports bpy lazily."""
+import ast
+from pathlib import Path
+
+BLENDER_MODULES = {"bpy", "mathutils", "bpy_extras", "bmesh", "addon_utils", "bl_math", "gpu"}
+PACKAGE = Path(__file__).resolve().parents[2] / "kinect_retarget"
+
+
+def _imports(path: Path, top_level_only: bool):
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    nodes = tree.body if top_level_only else ast.walk(tree)
+    for node in nodes:
+        if isinstance(node, ast.Import):
+            yield from (a.name.split(".")[0] for a in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            yield node.module.split(".")[0]
+
+
+def test_no_blender_imports_outside_blender_package():
+    offenders = []
+    for path in PACKAGE.rglob("*.py"):
+        rel = path.relative_to(PACKAGE)
+        if rel.parts[0] == "blender":
+            continue
+        # the package __init__ may import inside register(); everything else not at all
+        found = set(_imports(path, top_level_only=rel.name == "__init__.py" and len(rel.parts) == 1))
+        if found & BLENDER_MODULES:
+            offenders.append(f"{rel}: {sorted(found & BLENDER_MODULES)}")
+    assert not offenders, "Blender imports outside kinect_retarget/blender/: " + "; ".join(offenders)
+
+
+def test_core_imports_without_bpy():
+    import subprocess
+    import sys
+    code = ("import sys, kinect_retarget, kinect_retarget.core.pipeline, kinect_retarget.takes;"
+            "assert 'bpy' not in sys.modules and 'mathutils' not in sys.modules")
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=PACKAGE.parent)
