@@ -1,0 +1,48 @@
+"""Body proportions for the fitted Kinect v1 skeleton, calibrated from a standing performer.
+
+Ratios to standing height H (top of head to floor) are those of the MakeHuman reference body, which match
+common anthropometric tables; calibration measures H (and where the torso patch sits) on the first frames
+and scales them.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+# Heights above the floor (fraction of H) of the centre joints, and half-widths / bone lengths (fraction of H).
+HEIGHT_HIP_CENTER = 0.52
+HEIGHT_SPINE = 0.658
+HEIGHT_SHOULDER_CENTER = 0.844
+HEIGHT_HEAD = 0.951
+SHOULDER_HALF_WIDTH = 0.101
+SHOULDER_DROP = 0.038
+HIP_HALF_WIDTH = 0.066
+UPPER_ARM = 0.137
+FOREARM = 0.136
+HAND = 0.056
+THIGH = 0.252
+SHIN = 0.229
+FOOT = 0.041
+
+# How far behind the visible (front) surface each joint sits, metres: roughly the limb's radius.
+DEPTH_INSIDE = {"HipCenter": 0.09, "Spine": 0.09, "ShoulderCenter": 0.07, "Head": 0.08,
+                "Shoulder": 0.05, "Elbow": 0.04, "Wrist": 0.03, "Hand": 0.02,
+                "Hip": 0.08, "Knee": 0.05, "Ankle": 0.04, "Foot": 0.03}
+
+
+@dataclass
+class BodyCalibration:
+    height: float = 1.70               # standing height H, metres
+    torso_patch_height: float = 0.60   # height of the torso patch centroid above the floor, fraction of H
+    frames: int = 0                    # frames that contributed
+
+    def bone(self, ratio: float) -> float:
+        return ratio * self.height
+
+    def update(self, height: float, patch_height: float, rate: float = 0.2) -> None:
+        """Blend in one standing measurement (heights in metres above the floor)."""
+        if self.frames == 0:
+            self.height, self.torso_patch_height = height, patch_height / height
+        else:
+            self.height += rate * (height - self.height)
+            self.torso_patch_height += rate * (patch_height / self.height - self.torso_patch_height)
+        self.frames += 1

@@ -1,0 +1,152 @@
+"""Person segmentation on a downsampled depth grid: floor plane, depth range, connected components.
+
+Everything works on a strided grid (every `step`-th pixel), where a person 1.5-3.5 m away is still
+50-130 cells tall. Pixels keep the camera's layout (column u -> Kinect -X, see core/conventions.py).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .camera import DepthCamera
+
+MIN_Z, MAX_Z = 0.5, 4.5
+
+
+@dataclass
+class DepthGrid:
+    """A depth frame sampled every `step` pixels and back-projected to Kinect camera space."""
+    z: np.ndarray        # (h, w) metres, 0 = no reading
+    xyz: np.ndarray      # (h, w, 3) Kinect camera space
+    valid: np.ndarray    # (h, w) bool
+    step: int
+    camera: DepthCamera
+
+    @classmethod
+    def from_mm(cls, depth_mm: np.ndarray, camera: DepthCamera, step: int = 4) -> "DepthGrid":
+        z = depth_mm[step // 2::step, step // 2::step].astype(np.float64) * 0.001
+        h, w = z.shape
+        valid = (z > MIN_Z) & (z < MAX_Z)
+        z = np.where(valid, z, 0.0)
+        u = np.arange(w) * step + step // 2
+        v = np.arange(h) * step + step // 2
+        x = -(u[None, :] - camera.cx) * z / camera.f
+        y = -(v[:, None] - camera.cy) * z / camera.f
+        return cls(z, np.stack([x, y, z], axis=-1), valid, step, camera)
+
+    def to_pixel(self, points: np.ndarray) -> np.ndarray:
+        """(..., 3) Kinect points -> (..., 2) float grid coordinates (row, col)."""
+        c = self.camera
+        z = np.maximum(points[..., 2], 1e-6)
+        u = c.cx - c.f * points[..., 0] / z
+        v = c.cy - c.f * points[..., 1] / z
+        return np.stack([(v - self.step // 2) / self.step, (u - self.step // 2) / self.step], axis=-1)
+
+
+@dataclass
+class FloorPlane:
+    normal: np.ndarray   # unit, pointing up (against gravity)
+    offset: float        # height of a point p above the floor = normal . p + offset
+
+    def height(self, p: np.ndarray) -> np.ndarray:
+        return p @ self.normal + self.offset
+
+
+def fit_floor(grid: DepthGrid, gravity: np.ndarray | None, previous: FloorPlane | None = None) -> FloorPlane | None:
+    """Floor from gravity (accelerometer) and a least-squares plane fit to the lowest dense height band.
+
+    Returns None when no floor is visible (then no floor points are removed)."""
+    up = -np.asarray(gravity if gravity is not None else (0.0, -1.0, 0.0), dtype=np.float64)
+    up /= np.linalg.norm(up)
+    pts = grid.xyz[grid.valid]
+    if len(pts) < 200:
+        return previous
+    h = pts @ up
+    hist, edges = np.histogram(h, bins=np.arange(h.min(), h.max() + 0.04, 0.03))
+    dense = np.flatnonzero(hist >= max(60, 0.03 * len(pts)))
+    if len(dense) == 0:
+        return previous
+    level = edges[dense[0]] + 0.015
+    band = pts[np.abs(h - level) < 0.05]
+    if len(band) < 60:
+        return previous
+    centre = band.mean(axis=0)
+    _, _, vt = np.linalg.svd(band - centre, full_matrices=False)
+    n = vt[2] if vt[2] @ up > 0 else -vt[2]
+    if n @ up < np.cos(np.radians(10)):  # the band is not a floor (tilted fit): trust gravity alone
+        n = up
+    return FloorPlane(n, -float(n @ centre))
+
+
+def connected_components(mask: np.ndarray, z: np.ndarray, max_jump: float) -> np.ndarray:
+    """Label (h, w) int: 4-connected regions of `mask` with depth steps below max_jump; -1 outside.
+
+    Label propagation with pointer jumping (a few vectorised passes instead of a per-pixel flood fill).
+    """
+    h, w = mask.shape
+    idx = np.arange(h * w).reshape(h, w)
+    a_list, b_list = [], []
+    for da, db in ((mask[:, :-1] & mask[:, 1:] & (np.abs(z[:, :-1] - z[:, 1:]) < max_jump), (0, 1)),
+                   (mask[:-1, :] & mask[1:, :] & (np.abs(z[:-1, :] - z[1:, :]) < max_jump), (1, 0))):
+        a = idx[:h - db[0], :w - db[1]][da]
+        b = idx[db[0]:, db[1]:][da]
+        a_list.append(a)
+        b_list.append(b)
+    a = np.concatenate(a_list)
+    b = np.concatenate(b_list)
+    lab = idx.ravel().copy()
+    for _ in range(64):
+        la, lb = lab[a], lab[b]
+        m = np.minimum(la, lb)
+        changed = la != lb
+        if not changed.any():
+            break
+        np.minimum.at(lab, la[changed], m[changed])
+        np.minimum.at(lab, lb[changed], m[changed])
+        while True:
+            nxt = lab[lab]
+            if np.array_equal(nxt, lab):
+                break
+            lab = nxt
+    out = np.where(mask.ravel(), lab, -1).reshape(h, w)
+    return out
+
+
+@dataclass
+class PersonMask:
+    mask: np.ndarray      # (h, w) bool
+    centroid: np.ndarray  # (3,)
+    height: float         # vertical extent, metres
+    pixels: int
+
+
+def find_people(grid: DepthGrid, floor: FloorPlane | None, gravity: np.ndarray | None,
+                max_jump: float = 0.12) -> list[PersonMask]:
+    """Person-like connected components above the floor, largest first."""
+    fg = grid.valid.copy()
+    if floor is not None:
+        fg &= floor.height(grid.xyz) > 0.04
+    comps = connected_components(fg, grid.z, max_jump)
+    labels, counts = np.unique(comps[comps >= 0], return_counts=True)
+    up = -np.asarray(gravity if gravity is not None else (0.0, -1.0, 0.0), dtype=np.float64)
+    up /= np.linalg.norm(up)
+    people = []
+    cell = grid.step / grid.camera.f
+    for lab, n in zip(labels, counts):
+        if n < 40:
+            continue
+        m = comps == lab
+        pts = grid.xyz[m]
+        area = np.sum((pts[:, 2] * cell) ** 2)  # metric area of the visible surface
+        hts = pts @ up
+        vert = float(np.ptp(hts))
+        horiz = pts - np.outer(hts, up)
+        width = float(np.max(np.ptp(horiz, axis=0)))
+        if not (0.08 < area < 1.6 and 0.45 < vert < 2.4 and width < 1.6):
+            continue
+        if floor is not None and np.min(floor.height(pts)) > 0.9:  # floating blob (lamp, shelf item)
+            continue
+        people.append(PersonMask(m, pts.mean(axis=0), vert, int(n)))
+    people.sort(key=lambda p: -p.pixels)
+    return people

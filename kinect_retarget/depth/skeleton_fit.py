@@ -1,0 +1,233 @@
+"""Fit the 20-joint Kinect v1 skeleton to one segmented person (numpy only).
+
+Per frame: a torso patch (geodesic disc around the previous spine) gives the torso frame; geodesic
+extrema give head, hand and foot candidates; level-set centroids (paper 003) near each extremity give
+hand/wrist and foot/ankle; elbows and knees come from two-bone inverse kinematics with the calibrated
+bone lengths, choosing on the IK circle the point that best agrees with the depth image (projective
+check), the level-set centroid and the previous frame. Limbs without evidence keep their previous pose
+relative to the torso and are reported inferred.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED
+from . import body_model_fit as bm
+from .geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
+
+J = {n: i for i, n in enumerate(KINECT_V1.joints)}
+SIDES = ("Left", "Right")
+
+
+@dataclass
+class FitResult:
+    positions: np.ndarray
+    states: np.ndarray
+    lateral: np.ndarray
+    extrema: list = field(default_factory=list)   # [(label, xyz)] for previews and tests
+    torso_centre: np.ndarray | None = None
+    head_top: np.ndarray | None = None
+
+
+def _unit(v):
+    n = np.linalg.norm(v)
+    return v / n if n > 1e-9 else v
+
+
+def _nearest_cell(xyz: np.ndarray, mask: np.ndarray, p: np.ndarray) -> tuple[int, int] | None:
+    if not mask.any():
+        return None
+    d = np.where(mask, np.linalg.norm(xyz[..., :2] - p[:2], axis=-1) + 0.3 * np.abs(xyz[..., 2] - p[2]), np.inf)
+    k = int(np.argmin(d))
+    return divmod(k, mask.shape[1])
+
+
+class Projector:
+    """Projective agreement between 3D joint hypotheses and the cropped depth surface."""
+
+    def __init__(self, grid, crop, xyz, mask):
+        self.grid, self.r0, self.c0, self.xyz, self.mask = grid, crop[0], crop[1], xyz, mask
+
+    def cost(self, pts: np.ndarray, inside: float) -> np.ndarray:
+        rc = np.round(self.grid.to_pixel(pts)).astype(np.int64) - [self.r0, self.c0]
+        h, w = self.mask.shape
+        ok = (rc[:, 0] >= 0) & (rc[:, 0] < h) & (rc[:, 1] >= 0) & (rc[:, 1] < w)
+        r = np.clip(rc[:, 0], 0, h - 1)
+        c = np.clip(rc[:, 1], 0, w - 1)
+        on = ok & self.mask[r, c]
+        zs = self.xyz[r, c, 2]
+        dz = pts[:, 2] - (zs + inside)
+        cost = np.where(on, np.where(dz < -0.04, -dz, np.where(dz > 0.2, 0.08, 0.0)), 0.25)
+        return cost
+
+    def supported(self, p: np.ndarray, inside: float) -> bool:
+        return bool(self.cost(p[None], inside)[0] < 0.05)
+
+
+def two_bone_candidates(a: np.ndarray, c: np.ndarray, l1: float, l2: float, n: int = 16):
+    """Middle-joint candidates (n, 3) for root a, end c and bone lengths l1, l2, plus the end clamped to
+    reach."""
+    v = c - a
+    d = np.linalg.norm(v)
+    if d < 1e-6:
+        v, d = np.array([0.0, -1.0, 0.0]), 1e-6
+    u = v / d
+    if d >= l1 + l2 - 1e-6:  # out of reach: straight limb
+        return (a + u * l1)[None], a + u * (l1 + l2)
+    if d <= abs(l1 - l2):
+        d = abs(l1 - l2) + 1e-6
+    x = (d * d + l1 * l1 - l2 * l2) / (2 * d)
+    r = np.sqrt(max(l1 * l1 - x * x, 0.0))
+    ref = np.array([0.0, 0.0, 1.0]) if abs(u[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    e1 = _unit(np.cross(u, ref))
+    e2 = np.cross(u, e1)
+    ang = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    return a + u * x + r * (np.cos(ang)[:, None] * e1 + np.sin(ang)[:, None] * e2), a + u * d
+
+
+def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_states: np.ndarray | None,
+               prev_lateral: np.ndarray | None, prev_centre: np.ndarray | None = None,
+               prev_head_top: np.ndarray | None = None) -> FitResult | None:
+    rows, cols = np.nonzero(mask_full)
+    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
+    xyz = grid.xyz[r0:r1, c0:c1]
+    mask = mask_full[r0:r1, c0:c1]
+    graph = SurfaceGraph(xyz, mask)
+    proj = Projector(grid, (r0, c0), xyz, mask)
+    H = calib.height
+    # --- torso ---------------------------------------------------------------------------------------
+    seed_p = prev_centre if prev_centre is not None else grid.xyz[mask_full].mean(axis=0)
+    seed = _nearest_cell(xyz, mask, seed_p)
+    if seed is None:
+        return None
+    d0 = graph.distances(np.array([seed]))
+    patch = xyz[d0 < 0.12 * H]
+    if len(patch) < 10:
+        return None
+    centre = patch.mean(axis=0)
+    _, _, vt = np.linalg.svd(patch - centre, full_matrices=False)
+    axis = vt[0] if vt[0] @ up > 0 else -vt[0]
+    axis = _unit(0.5 * axis + 0.5 * up) if axis @ up > 0.5 else up  # crouched/odd patch: trust gravity
+    view = _unit(centre)
+    lat = _unit(np.cross(view, axis))  # points to the performer's left when facing the sensor
+    if prev_lateral is not None and lat @ prev_lateral < 0:
+        lat = -lat
+    inside = lambda name: view * bm.DEPTH_INSIDE[name]
+    # --- extremities ---------------------------------------------------------------------------------
+    extrema = geodesic_extrema(graph, d0, count=6, min_distance=0.15 * H)
+    cand = []
+    for r, c, dist in extrema:
+        p = xyz[r, c]
+        cand.append(((r, c), p, dist, (p - centre) @ axis, (p - centre) @ lat))
+    heady = [e for e in cand if e[3] > -0.05 * H and abs(e[4]) < 0.15 * H]
+    if prev_head_top is not None:
+        near = [e for e in heady if np.linalg.norm(e[1] - prev_head_top) < 0.25]
+        heady = near or heady
+    head = max(heady, key=lambda e: e[1] @ up, default=None)
+    # the head top pins the torso along its axis (the torso patch alone drifts along the body)
+    if head is not None:
+        anchored = head[1] - axis * (1.0 - calib.torso_patch_height) * H
+        centre = centre + axis * ((anchored - centre) @ axis)
+    def along(h_frac: float) -> np.ndarray:
+        return centre + axis * (h_frac - calib.torso_patch_height) * H
+
+    pos = np.zeros((20, 3))
+    st = np.full(20, INFERRED, np.uint8)
+    for name, hf in (("HipCenter", bm.HEIGHT_HIP_CENTER), ("Spine", bm.HEIGHT_SPINE),
+                     ("ShoulderCenter", bm.HEIGHT_SHOULDER_CENTER)):
+        pos[J[name]] = along(hf) + inside(name)
+        st[J[name]] = TRACKED
+    rest = [e for e in cand if e is not head]
+    feet = sorted([e for e in rest if e[3] < -0.33 * H], key=lambda e: -e[2])[:2]
+    hands = sorted([e for e in rest if e not in feet and e[3] > -0.35 * H], key=lambda e: -e[2])[:2]
+    labels = []
+    if head is not None:
+        dh = graph.distances(np.array([head[0]]), iterations=6)
+        hc = level_set_centroid(xyz, dh, 0.06 * H, 0.04, head[1], 0.2)
+        pos[J["Head"]] = (hc if hc is not None else head[1] - axis * 0.05 * H) + inside("Head")
+        st[J["Head"]] = TRACKED
+        labels.append(("head", head[1]))
+    else:
+        pos[J["Head"]] = pos[J["ShoulderCenter"]] + axis * (bm.HEIGHT_HEAD - bm.HEIGHT_SHOULDER_CENTER) * H
+    sc, hc_ = pos[J["ShoulderCenter"]], pos[J["HipCenter"]]
+    for s, sign in (("Left", 1.0), ("Right", -1.0)):
+        pos[J[f"Shoulder{s}"]] = sc + lat * sign * bm.SHOULDER_HALF_WIDTH * H - axis * bm.SHOULDER_DROP * H
+        pos[J[f"Hip{s}"]] = hc_ + lat * sign * bm.HIP_HALF_WIDTH * H
+        st[J[f"Shoulder{s}"]] = st[J[f"Hip{s}"]] = TRACKED
+    # --- limbs ---------------------------------------------------------------------------------------
+    limb_specs = (("Shoulder", "Elbow", "Wrist", "Hand", bm.UPPER_ARM, bm.FOREARM, hands, 0.08, 0.08 + bm.HAND * H),
+                  ("Hip", "Knee", "Ankle", "Foot", bm.THIGH, bm.SHIN, feet, 0.07, 0.15))
+    for root, mid, end, tip, r1, r2, found, d_tip, d_end in limb_specs:
+        assign = _assign_sides(found, prev, prev_states, tip, lat, centre)
+        for s in SIDES:
+            e = assign.get(s)
+            a = pos[J[f"{root}{s}"]]
+            l1, l2 = r1 * H, r2 * H
+            if e is not None:
+                de = graph.distances(np.array([e[0]]), iterations=8)
+                tip_p = level_set_centroid(xyz, de, d_tip, 0.05, e[1], 0.2)
+                end_p = level_set_centroid(xyz, de, d_end, 0.05, e[1], 0.3)
+                tip_p = (e[1] if tip_p is None else tip_p) + inside(tip)
+                end_p = (tip_p if end_p is None else end_p + inside(end))
+                mid_ls = level_set_centroid(xyz, de, d_end + l2, 0.06, end_p, l2 + 0.1)
+                labels.append((f"{tip}{s}", e[1]))
+                st_limb = TRACKED
+            else:
+                end_p, tip_p, mid_ls = _carry(prev, s, end, tip, a, axis, pos, root)
+                st_limb = INFERRED
+            cands, end_p2 = two_bone_candidates(a, end_p, l1, l2)
+            cost = proj.cost(cands, bm.DEPTH_INSIDE[mid])
+            if mid_ls is not None:
+                cost = cost + 0.5 * np.linalg.norm(cands - (mid_ls + inside(mid)), axis=1)
+            if prev is not None and prev_states is not None and prev_states[J[f"{mid}{s}"]] != NOT_TRACKED:
+                cost = cost + 0.3 * np.linalg.norm(cands - prev[J[f"{mid}{s}"]], axis=1)
+            else:  # no history: elbows bend backwards/outwards, knees forwards
+                pref = -view if root == "Hip" else (view + lat * (1 if s == "Left" else -1))
+                cost = cost - 0.02 * ((cands - a) @ _unit(pref))
+            m = cands[int(np.argmin(cost))]
+            pos[J[f"{mid}{s}"]] = m
+            shift = end_p2 - end_p  # keep the hand/foot attached when the end was pulled into reach
+            pos[J[f"{end}{s}"]] = end_p2
+            pos[J[f"{tip}{s}"]] = tip_p + shift
+            mid_ok = st_limb == TRACKED and proj.supported(m, bm.DEPTH_INSIDE[mid] - 0.02)
+            st[J[f"{mid}{s}"]] = TRACKED if mid_ok or st_limb == TRACKED else INFERRED
+            st[J[f"{end}{s}"]] = st[J[f"{tip}{s}"]] = st_limb
+    return FitResult(pos, st, lat, labels, centre, None if head is None else head[1])
+
+
+def _carry(prev, s, end, tip, root_pos, axis, pos, root):
+    """A limb with no extremity found: its previous pose moved with the torso, or hanging straight."""
+    if prev is not None:
+        delta = root_pos - prev[J[f"{root}{s}"]]
+        return prev[J[f"{end}{s}"]] + delta, prev[J[f"{tip}{s}"]] + delta, None
+    if root == "Shoulder":
+        e = root_pos - axis * 0.26
+        return e, e - axis * 0.08, None
+    e = root_pos - axis * 0.46
+    return e, e - axis * 0.04 + _unit(-root_pos) * 0.08, None
+
+
+def _assign_sides(found, prev, prev_states, tip, lat, centre) -> dict:
+    """Give each found extremity a side: by continuity with the previous frame, else by body side."""
+    if not found:
+        return {}
+    have_prev = prev is not None and prev_states is not None and all(
+        prev_states[J[f"{tip}{s}"]] != NOT_TRACKED for s in SIDES)
+    if len(found) == 2:
+        if have_prev:
+            a = sum(np.linalg.norm(f[1] - prev[J[f"{tip}{s}"]]) for f, s in zip(found, SIDES))
+            b = sum(np.linalg.norm(f[1] - prev[J[f"{tip}{s}"]]) for f, s in zip(found[::-1], SIDES))
+            # body side wins when continuity is ambiguous (both hands near each other)
+            side_a = (found[0][4] - found[1][4])
+            if abs(a - b) < 0.05:
+                return dict(zip(SIDES, found if side_a > 0 else found[::-1]))
+            return dict(zip(SIDES, found if a <= b else found[::-1]))
+        return dict(zip(SIDES, found if found[0][4] >= found[1][4] else found[::-1]))
+    f = found[0]
+    if have_prev:
+        dl = np.linalg.norm(f[1] - prev[J[f"{tip}Left"]])
+        dr = np.linalg.norm(f[1] - prev[J[f"{tip}Right"]])
+        return {"Left" if dl <= dr else "Right": f}
+    return {"Left" if f[4] >= 0 else "Right": f}
