@@ -1,0 +1,167 @@
+"""Format detection on every real file and fixture, and clear errors (file and line) on corrupted copies."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from kinect_retarget.core.take import TakeError
+from kinect_retarget.takes import READERS, detect_format, load_take
+from tests.takes import format_fixtures as fx
+
+REAL = {  # path under shared data: expected format
+    **{f"kinect_v2/{n}": "kinect_v2_csv" for n in (
+        "Ges01_wavehand.csv", "Ges02_balancinghands.csv", "Ges03_drawlines.csv", "Ges04_comehere.csv",
+        "Ges05_demopoint.csv", "Ges06_chickenwing.csv", "joints.csv")},
+    "kinect_v2/recorded_skeleton.json": "kinectron_json",
+    **{f"mocap_bvh/{n}": "bvh" for n in ("01_01.bvh", "131_01.bvh", "131_02.bvh", "131_03.bvh")},
+    "meshes/makehuman/tpose.bvh": "bvh",
+    "meshes/makehuman/benchmark.bvh": "bvh",
+}
+FIXTURE_FORMATS = {"ntu": "ntu_skeleton", "msrc12": "msrc12", "utkinect": "utkinect"}
+
+
+@pytest.mark.parametrize("rel", sorted(REAL))
+def test_detects_real_files(shared_data, rel):
+    assert detect_format(shared_data / rel) == REAL[rel]
+
+
+@pytest.mark.parametrize("name", sorted(FIXTURE_FORMATS))
+def test_detects_converted_fixtures(name):
+    path = {"ntu": "S001C001P001R001A001_converted_Ges01.skeleton", "msrc12": "P1_1_1_converted_joints.csv",
+            "utkinect": "joints_s01_e01_converted_joints.txt"}[name]
+    assert detect_format(fx.FIXTURES / path) == FIXTURE_FORMATS[name]
+    assert load_take(fx.FIXTURES / path).frame_count > 30
+
+
+def test_detection_ignores_extension(shared_data, tmp_path):
+    (tmp_path / "take.txt").write_bytes((shared_data / "mocap_bvh" / "131_01.bvh").read_bytes())
+    (tmp_path / "take.bvh").write_bytes((shared_data / "kinect_v2" / "Ges02_balancinghands.csv").read_bytes())
+    assert detect_format(tmp_path / "take.txt") == "bvh"
+    assert detect_format(tmp_path / "take.bvh") == "kinect_v2_csv"
+
+
+def test_unknown_and_empty(tmp_path, shared_data):
+    (tmp_path / "notes.csv").write_text("name,value\nfoo,1\n")
+    with pytest.raises(TakeError, match=r"notes\.csv: unknown take format \(supported: "):
+        load_take(tmp_path / "notes.csv")
+    (tmp_path / "empty.csv").write_bytes(b"")
+    with pytest.raises(TakeError, match=r"empty\.csv: file is empty"):
+        load_take(tmp_path / "empty.csv")
+    # Plain comma-separated numbers of another width are not taken for Kinect v2 CSV.
+    (tmp_path / "numbers.csv").write_text("1,2,3\n4,5,6\n")
+    with pytest.raises(TakeError, match=r"numbers\.csv: unknown take format"):
+        load_take(tmp_path / "numbers.csv")
+
+
+# --- corrupted copies: each line-based format, each corruption, the exact line named ---------------------
+
+LINE_FORMATS = {  # format: (source file, index of a data line to damage, field separator)
+    "kinect_v2_csv": ("shared:kinect_v2/Ges01_wavehand.csv", 40, ","),
+    "bvh": ("shared:mocap_bvh/131_02.bvh", 300, " "),
+    "msrc12": ("fixture:P1_1_1_converted_joints.csv", 20, " "),
+    "utkinect": ("fixture:joints_s01_e01_converted_joints.txt", 20, " "),
+    "ntu_skeleton": ("fixture:S001C001P001R001A001_converted_Ges01.skeleton", 210, " "),  # a joint line
+}
+
+
+def _source(shared_data, spec):
+    kind, rel = spec.split(":", 1)
+    return (shared_data / rel) if kind == "shared" else fx.FIXTURES / rel
+
+
+def _damage(lines, i, sep, how):
+    fields = lines[i].rstrip("\r\n").rstrip(sep).split(sep)
+    if how == "truncated":
+        return lines[:i] + [sep.join(fields[:len(fields) // 2])]
+    if how == "columns":
+        return lines[:i] + [sep.join(fields[:-1]) + "\n"] + lines[i + 1:]
+    if how == "nan":
+        fields[2] = "nan"
+    elif how == "garbage":
+        fields[2] = "x=#!"
+    return lines[:i] + [sep.join(fields) + "\n"] + lines[i + 1:]
+
+
+EXPECTED = {
+    "truncated": r"{name}:{line}: (expected \d+ values.*found \d+|file ends inside frame)",
+    "columns": r"{name}:{line}: expected \d+ values.*found \d+",
+    "nan": r"{name}:{line}: NaN or infinite value",
+    "garbage": r"{name}:{line}: non-numeric value 'x=#!'",
+}
+
+
+@pytest.mark.parametrize("how", sorted(EXPECTED))
+@pytest.mark.parametrize("fmt", sorted(LINE_FORMATS))
+def test_corrupted_line_formats(shared_data, tmp_path, fmt, how):
+    spec, i, sep = LINE_FORMATS[fmt]
+    src = _source(shared_data, spec)
+    lines = src.read_text().splitlines(keepends=True)
+    name = f"bad_{how}{src.suffix}"
+    (tmp_path / name).write_text("".join(_damage(lines, i, sep, how)))
+    with pytest.raises(TakeError, match=EXPECTED[how].format(name=name.replace(".", r"\."), line=i + 1)):
+        load_take(tmp_path / name)
+
+
+@pytest.mark.parametrize("fmt", sorted(LINE_FORMATS))
+def test_empty_copy(tmp_path, fmt):
+    path = tmp_path / f"empty_{fmt}"
+    path.write_text("\n\n")
+    with pytest.raises(TakeError, match=r"file is empty"):
+        load_take(path)
+    from importlib import import_module
+    with pytest.raises(TakeError, match=r"file is empty"):
+        import_module(f"kinect_retarget.takes.{fmt}").read(path)
+
+
+def test_no_tracked_frame(shared_data, tmp_path):
+    lines = (shared_data / "kinect_v2" / "joints.csv").read_text().splitlines()
+    dead = []
+    for line in lines[:10]:
+        fields = line.rstrip(",").split(",")
+        fields[4::4] = ["0"] * 25
+        dead.append(",".join(fields))
+    (tmp_path / "dead.csv").write_text("\n".join(dead) + "\n")
+    with pytest.raises(TakeError, match=r"dead\.csv: no joint is tracked in any frame"):
+        load_take(tmp_path / "dead.csv")
+    fields = lines[3].split(",")
+    fields[8] = "3"
+    (tmp_path / "state.csv").write_text("\n".join(lines[:3] + [",".join(fields)] + lines[4:]) + "\n")
+    with pytest.raises(TakeError, match=r"state\.csv:4: tracking state must be 0, 1 or 2"):
+        load_take(tmp_path / "state.csv")
+    (tmp_path / "time.csv").write_text("\n".join(lines[:5] + [lines[2]] + lines[6:]) + "\n")
+    with pytest.raises(TakeError, match=r"time\.csv:6: timestamp \d+ is not after"):
+        load_take(tmp_path / "time.csv")
+
+
+def test_corrupted_kinectron(shared_data, tmp_path):
+    text = (shared_data / "kinect_v2" / "recorded_skeleton.json").read_text()
+    raw = json.loads(text)
+    (tmp_path / "cut.json").write_text(text[: len(text) // 2])
+    with pytest.raises(TakeError, match=r"cut\.json:1: invalid JSON at column \d+"):
+        load_take(tmp_path / "cut.json")
+    cases = {
+        "joints.json": (lambda r: r[7].__setitem__("joints", r[7]["joints"][:24]),
+                        r"joints\.json: record 7: expected 25 joints, found 24"),
+        "key.json": (lambda r: r[9]["joints"][3].pop("cameraY"), r"key\.json: record 9: joint without 'cameraY'"),
+        "nan.json": (lambda r: r[11]["joints"][3].__setitem__("cameraZ", float("nan")),
+                     r"nan\.json: record 11: NaN"),
+        "text.json": (lambda r: r[12]["joints"][0].__setitem__("cameraX", "left"),
+                      r"text\.json: record 12: non-numeric"),
+        "time.json": (lambda r: r[20].__setitem__("record_timestamp", r[10]["record_timestamp"]),
+                      r"time\.json: record 20: record_timestamp"),
+        "none.json": (lambda r: [f.__setitem__("tracked", False) for f in r],
+                      r"none\.json: no tracked body in any of its 286 records"),
+    }
+    for name, (edit, pattern) in cases.items():
+        doc = json.loads(text)
+        edit(doc)
+        (tmp_path / name).write_text(json.dumps(doc))
+        with pytest.raises(TakeError, match=pattern):
+            load_take(tmp_path / name)
+    assert len(raw) == 286
+
+
+def test_readers_registered():
+    assert {"krtake", "bvh", "kinect_v2_csv", "kinectron_json", "ntu_skeleton", "msrc12",
+            "utkinect"} <= set(READERS)
