@@ -98,14 +98,17 @@ def bench_kinectron(noise_px: float = 0.0) -> None:
     take, two_d = kinectron_json.read_with_2d(DATA / "kinect_v2" / "recorded_skeleton.json")
     idx = [KINECT_V2.index(V1_FROM_V2[n]) for n in KINECT_V1.joints]
     truth = take.positions[:, idx]
-    uv = two_d["color_px"][:, idx]
+    uv = two_d["color_px"][:, idx].copy()
+    # Kinect v2 colour frames are mirrored: a fit of u to X/Z gives u = +1059 X/Z + 995 (ours is cx - f X/Z).
+    uv[..., 0] = kinectron_json.COLOR_SIZE[0] - uv[..., 0]
+    principal = (kinectron_json.COLOR_SIZE[0] - 995.4, 540.8)
     ok = take.states[:, idx] > 0
     tracks = Tracks2D(uv, ok.astype(float), take.times, kinectron_json.COLOR_SIZE, source="kinectron")
     v1 = Take(KINECT_V1, truth, take.states[:, idx], take.times, take.rate)
     for label, lengths in (("calibrated lengths", lengths_from_take(v1)),
                            ("anthropometric (height 1.70 m)", lengths_from_height(1.70))):
         for focal in (1062.0, None):
-            res = lift(tracks, LiftSettings(lengths=lengths, focal_px=focal))
+            res = lift(tracks, LiftSettings(lengths=lengths, focal_px=focal, principal_point=principal))
             pred = res.take.positions
             m = ok.all(axis=1)
             print(f"  kinectron, {label}, focal {'1062 px' if focal else 'unknown'}: PA-MPJPE "

@@ -10,15 +10,18 @@ from ..core.skeletons import KINECT_V1, NOT_TRACKED, Skeleton
 from ..core.take import Take
 from .tracks2d import LiftError
 
-# Segment lengths as fractions of standing height (Winter, "Biomechanics and Motor Control of Human
-# Movement", segment-length figure), split onto Kinect v1 joints.
+# Bone lengths as fractions of standing height, for the Kinect v1 joint positions. Legs follow Winter
+# ("Biomechanics and Motor Control of Human Movement": thigh 0.245 H, shank 0.246 H); the rest are measured
+# on the CMU optical takes sampled at Kinect v1 joints (takes/bvh.py), with each subject's height taken
+# from their legs, so lifted takes match what the retargeting engine sees from a Kinect.
 HEIGHT_RATIOS = {
-    "Spine": 0.100, "ShoulderCenter": 0.186, "Head": 0.110,
-    "ShoulderLeft": 0.110, "ElbowLeft": 0.172, "WristLeft": 0.146, "HandLeft": 0.050,
-    "ShoulderRight": 0.110, "ElbowRight": 0.172, "WristRight": 0.146, "HandRight": 0.050,
-    "HipLeft": 0.055, "KneeLeft": 0.245, "AnkleLeft": 0.246, "FootLeft": 0.090,
-    "HipRight": 0.055, "KneeRight": 0.245, "AnkleRight": 0.246, "FootRight": 0.090,
+    "Spine": 0.102, "ShoulderCenter": 0.080, "Head": 0.096,
+    "ShoulderLeft": 0.105, "ElbowLeft": 0.160, "WristLeft": 0.116, "HandLeft": 0.030,
+    "ShoulderRight": 0.105, "ElbowRight": 0.160, "WristRight": 0.116, "HandRight": 0.030,
+    "HipLeft": 0.077, "KneeLeft": 0.245, "AnkleLeft": 0.246, "FootLeft": 0.077,
+    "HipRight": 0.077, "KneeRight": 0.245, "AnkleRight": 0.246, "FootRight": 0.077,
 }
+_LEG_RATIO = 0.491  # thigh + shank
 DEFAULT_HEIGHT_M = 1.70
 
 
@@ -53,7 +56,7 @@ def lengths_scaled_to_height(lengths: np.ndarray, height_m: float,
 
 
 def standing_height(lengths: np.ndarray, skeleton: Skeleton = KINECT_V1) -> float:
-    """Head-top height of a straight standing skeleton: legs + spine + neck/head + a head radius."""
+    """Standing height implied by a skeleton's legs (the most stable anthropometric relation)."""
     L = dict(zip(skeleton.joints, np.asarray(lengths)))
     legs = 0.5 * (L["KneeLeft"] + L["AnkleLeft"] + L["KneeRight"] + L["AnkleRight"])
-    return float(legs + L["Spine"] + L["ShoulderCenter"] + 1.6 * L["Head"] + 0.045 * (legs / 0.49))
+    return float(legs / _LEG_RATIO)

@@ -16,6 +16,7 @@ from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED, topologi
 from ..core.take import Take, nominal_rate
 from .bones import DEFAULT_HEIGHT_M, lengths_from_height
 from .camera import Camera
+from .depth import depth_magnitude, jitter_px
 from .gaps import fill_gaps
 from .scale import SCALE_BONES, fill_missing, smooth_lengths, scale_envelope, scale_lower_bound, scale_paper
 from .smoothing import gaussian_smooth
@@ -48,14 +49,17 @@ class LiftSettings:
     lengths: np.ndarray | None = None
     focal_px: float | None = None
     image_size: tuple[float, float] | None = None
+    principal_point: tuple[float, float] | None = None  # pixels; default the image centre
     scale: str = "envelope"
     scale_window_s: float = 1.0
-    scale_quantile: float = 0.9
+    scale_quantile: float = 0.8
     signs: str = "viterbi"
     priors: SignPriors = field(default_factory=SignPriors)
     max_gap_s: float = 0.5
     smooth_2d_s: float = 0.05
     smooth_depth_s: float = 0.08
+    noise_aware: bool = True
+    noise_px: float | None = None  # 2D noise (std, px); None: measured from the tracks' jitter
     min_confidence: float = 0.05
 
 
@@ -78,6 +82,7 @@ def lift(tracks: Tracks2D, settings: LiftSettings | None = None) -> LiftResult:
     present = tracks.confidence >= st.min_confidence
     uv, filled = fill_gaps(tracks.uv, present, tracks.times, st.max_gap_s)
     have = present | filled
+    noise_px = jitter_px(uv, present & ~filled) if st.noise_px is None else st.noise_px
     uv = gaussian_smooth(uv, have[..., None], tracks.times, st.smooth_2d_s)
     body = have[:, SK.root]
     for i in np.flatnonzero(~body & have.any(axis=1)):
@@ -102,12 +107,17 @@ def lift(tracks: Tracks2D, settings: LiftSettings | None = None) -> LiftResult:
         raise LiftError(f"unknown scale method {st.scale!r} (envelope, paper)")
 
     dxy = np.where(bone_ok[..., None], d_vec / s[:, None, None], 0.0)
-    dz = np.where(bone_ok, np.sqrt(np.maximum(0.0, lengths ** 2 - np.sum(dxy ** 2, axis=-1))), 0.0)
+    c_obs = np.linalg.norm(dxy, axis=-1) / np.maximum(lengths, 1e-9)
+    if st.noise_aware:  # 2D jitter left after smoothing, as foreshortening noise of each bone
+        sigma_c = np.sqrt(2.0) * noise_px * _smoothing_gain(tracks.times, st.smooth_2d_s) / (s[:, None] * np.maximum(lengths, 1e-9))
+    else:
+        sigma_c = 0.0
+    dz = np.where(bone_ok, lengths * depth_magnitude(c_obs, sigma_c), 0.0)
     travel = _travel_direction(xy[:, SK.root] / s[:, None], cam.focal_px / s, tracks.times, body)
     signs = choose_signs(dxy, dz, tracks.times, body, travel, st.priors, st.signs)
 
-    positions = _place_joints(uv, have, s, signs, lengths, cam, st.focal_px is not None,
-                              tracks.times, body, st.smooth_depth_s)
+    signed_dz = gaussian_smooth(signs * dz, bone_ok & body[:, None], tracks.times, st.smooth_depth_s)
+    positions = _place_joints(uv, have, s, signed_dz, lengths, cam, st.focal_px is not None)
     states = np.where(measured & ~filled, TRACKED, INFERRED).astype(np.uint8)
     states[~body] = NOT_TRACKED
     positions[~body] = np.nan
@@ -116,6 +126,17 @@ def lift(tracks: Tracks2D, settings: LiftSettings | None = None) -> LiftResult:
             "scale_method": st.scale, "sign_method": st.signs, "problems": len(problems)}
     take = Take(SK, positions, states, tracks.times, rate, "lift", meta)
     return LiftResult(take, s, signs, cam, problems)
+
+
+def _smoothing_gain(times: np.ndarray, sigma_s: float) -> float:
+    """Factor by which gaussian_smooth reduces white noise (the kernel's L2 norm)."""
+    if len(times) < 3 or sigma_s <= 0:
+        return 1.0
+    sig = sigma_s / float(np.median(np.diff(times)))
+    if sig < 0.3:
+        return 1.0
+    k = np.exp(-0.5 * (np.arange(-int(np.ceil(3 * sig)), int(np.ceil(3 * sig)) + 1) / sig) ** 2)
+    return float(np.sqrt(np.sum((k / k.sum()) ** 2)))
 
 
 def _camera(tracks: Tracks2D, st: LiftSettings, problems: list[str]) -> Camera:
@@ -134,7 +155,10 @@ def _camera(tracks: Tracks2D, st: LiftSettings, problems: list[str]) -> Camera:
         raise LiftError(f"image size must be positive, got {w} x {h}")
     if st.focal_px is not None and not st.focal_px > 0:
         raise LiftError(f"focal length must be positive, got {st.focal_px}")
-    return Camera.for_image(w, h, st.focal_px)
+    cam = Camera.for_image(w, h, st.focal_px)
+    if st.principal_point is not None:
+        cam = Camera(cam.focal_px, float(st.principal_point[0]), float(st.principal_point[1]), cam.focal_known)
+    return cam
 
 
 def _travel_direction(root_xy: np.ndarray, root_z: np.ndarray, times: np.ndarray, body: np.ndarray):
@@ -164,11 +188,10 @@ _DEFAULT_DIR.update({"Spine": _UP, "ShoulderCenter": _UP, "Head": _UP,
                      "HipLeft": np.array([-0.9, -0.45, 0]), "HipRight": np.array([0.9, -0.45, 0])})
 
 
-def _place_joints(uv, have, s, signs, lengths, cam: Camera, perspective: bool, times, body,
-                  smooth_s: float) -> np.ndarray:
-    """Walk the tree from the pelvis, putting each joint on its image ray (or orthographic line) at its
-    bone's length from the parent, on the chosen depth side. The bone's signed depth offset is smoothed
-    over time first: near the image plane it is very sensitive to 2D noise."""
+def _place_joints(uv, have, s, signed_dz, lengths, cam: Camera, perspective: bool) -> np.ndarray:
+    """Walk the tree from the pelvis: each joint at its parent's depth plus its bone's signed depth offset,
+    on its image ray (perspective) or its orthographic line, so it reprojects onto its 2D track exactly.
+    Joints never seen hang from their parent in a default direction."""
     f = uv.shape[0]
     pos = np.full((f, len(SK), 3), np.nan)
     z_root = cam.focal_px / s
@@ -177,23 +200,13 @@ def _place_joints(uv, have, s, signs, lengths, cam: Camera, perspective: bool, t
     pos[:, r] = rays[:, r] * z_root[:, None]
     fwd = None
     for j in ORDER[1:]:
-        p = PARENTS[j]
-        parent = pos[:, p]
-        if perspective:
-            o, d = np.zeros((f, 3)), rays[:, j]
-        else:  # orthographic: the line through the joint's (X, Y) along the optical axis
-            o = np.concatenate([rays[:, j, :2] * z_root[:, None], np.zeros((f, 1))], axis=1)
-            d = np.tile([0.0, 0.0, 1.0], (f, 1))
-        a = np.sum(d * d, axis=1)
-        b = 2 * np.sum(d * (o - parent), axis=1)
-        c = np.sum((o - parent) ** 2, axis=1) - lengths[j] ** 2
-        t = (-b + signs[:, j] * np.sqrt(np.maximum(b * b - 4 * a * c, 0.0))) / (2 * a)
-        dz = gaussian_smooth(o[:, 2] + t * d[:, 2] - parent[:, 2], have[:, j] & body, times, smooth_s)
-        on_ray = o + ((parent[:, 2] + dz - o[:, 2]) / d[:, 2])[:, None] * d
-        if fwd is None and j in (SK.index("FootLeft"), SK.index("FootRight")):
+        parent = pos[:, PARENTS[j]]
+        z = parent[:, 2] + signed_dz[:, j]
+        xy_z = z if perspective else z_root  # orthographic: X, Y from the root's depth
+        on_ray = np.concatenate([rays[:, j, :2] * xy_z[:, None], z[:, None]], axis=1)
+        if fwd is None and SK.joints[j].startswith("Foot"):
             fwd = _forward(pos)
-        default = _default_direction(SK.joints[j], pos, p, fwd)
-        guessed = parent + lengths[j] * default
+        guessed = parent + lengths[j] * _default_direction(SK.joints[j], pos, PARENTS[j], fwd)
         pos[:, j] = np.where(have[:, j, None], on_ray, guessed)
     return pos
 
