@@ -33,6 +33,8 @@ ROLES = {
     "Shoulder": "clavicle", "Elbow": "upper_arm", "Wrist": "forearm", "Hand": "hand", "HandTip": "hand",
     "Thumb": "hand", "Hip": "hip", "Knee": "thigh", "Ankle": "shin", "Foot": "foot",
 }
+LIMB_LEVELS = {"upper_arm": ("arm", 0), "forearm": ("arm", 1), "hand": ("arm", 2),
+               "thigh": ("leg", 0), "shin": ("leg", 1), "foot": ("leg", 2)}
 HINGE_BLEND = 0.1  # weight of the default hinge: it takes over below a bend of about 6 degrees
 
 GetJoint = Callable[[str], "np.ndarray | None"]
@@ -92,9 +94,18 @@ def up_vector(get: GetJoint, fallback: np.ndarray) -> np.ndarray:
     return fallback if v is None else v
 
 
+def rotate_minimal(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Rotate v by the smallest rotation taking unit a to unit b (Rodrigues without normalising the axis;
+    a and b are never opposite for neighbouring limb segments)."""
+    k = np.cross(a, b)
+    c = np.sum(a * b, axis=-1, keepdims=True)
+    return v * c + np.cross(k, v) + k * np.sum(k * v, axis=-1, keepdims=True) / np.maximum(1.0 + c, 1e-9)
+
+
 def hinge_axis(get: GetJoint, side: str, kind: str, y_upper: np.ndarray, world_lateral: np.ndarray,
                world_up: np.ndarray) -> np.ndarray:
-    """Hinge axis of the elbow (kind 'arm') or knee ('leg') on one side; (..., 3), not normalised."""
+    """Hinge axis of the elbow (kind 'arm') or knee ('leg') on one side, as seen by the upper segment;
+    (..., 3), not normalised."""
     a, b, c = (("Shoulder", "Elbow", "Wrist") if kind == "arm" else ("Hip", "Knee", "Ankle"))
     upper = _sub(get(b + side), get(a + side))
     lower = _sub(get(c + side), get(b + side))
@@ -112,6 +123,24 @@ def hinge_axis(get: GetJoint, side: str, kind: str, y_upper: np.ndarray, world_l
     return bend + HINGE_BLEND * normalize(default)
 
 
+def limb_hint(get: GetJoint, side: str, kind: str, level: int, y: np.ndarray, world_lateral: np.ndarray,
+              world_up: np.ndarray) -> np.ndarray:
+    """X hint for the upper (level 0), lower (1) or end (2: hand, foot) segment of a limb. Lower segments
+    carry the upper segment's hinge across by the minimal rotation between the segments, so nothing
+    twists at the elbow, knee, wrist or ankle."""
+    names = (("Shoulder", "Elbow", "Wrist", "Hand") if kind == "arm" else ("Hip", "Knee", "Ankle", "Foot"))
+    dirs = [_sub(get(names[i + 1] + side), get(names[i] + side)) for i in range(3)]
+    y_upper = y if level == 0 or dirs[0] is None else dirs[0]
+    hint = hinge_axis(get, side, kind, y_upper, world_lateral, world_up)
+    for i in range(1, level + 1):
+        prev = y_upper if i == 1 else dirs[i - 1]
+        cur = y if i == level or dirs[i] is None else dirs[i]
+        if prev is None:
+            break
+        hint = rotate_minimal(hint, normalize(prev), normalize(cur))
+    return hint
+
+
 def segment_hint(get: GetJoint, tail: str, y: np.ndarray, world_lateral: np.ndarray,
                  world_up: np.ndarray) -> np.ndarray:
     """The X-direction hint for the segment ending at joint `tail` whose direction is `y`."""
@@ -122,8 +151,5 @@ def segment_hint(get: GetJoint, tail: str, y: np.ndarray, world_lateral: np.ndar
         return np.cross(y, lateral(get, upper=True, fallback=world_lateral))
     if role in ("clavicle", "hip"):
         return np.cross(y, up_vector(get, world_up))
-    if role in ("upper_arm", "forearm", "hand"):
-        upper = _sub(get("Elbow" + side), get("Shoulder" + side))
-        return hinge_axis(get, side, "arm", y if upper is None else upper, world_lateral, world_up)
-    upper = _sub(get("Knee" + side), get("Hip" + side))
-    return hinge_axis(get, side, "leg", y if upper is None else upper, world_lateral, world_up)
+    kind, level = LIMB_LEVELS[role]
+    return limb_hint(get, side, kind, level, y, world_lateral, world_up)
