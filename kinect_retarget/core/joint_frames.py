@@ -36,6 +36,7 @@ ROLES = {
 LIMB_LEVELS = {"upper_arm": ("arm", 0), "forearm": ("arm", 1), "hand": ("arm", 2),
                "thigh": ("leg", 0), "shin": ("leg", 1), "foot": ("leg", 2)}
 HINGE_BLEND = 0.1  # weight of the default hinge: it takes over below a bend of about 6 degrees
+HINGE_FADE = 0.3   # sine of the bend (about 17 degrees) above which the default has no say
 
 GetJoint = Callable[[str], "np.ndarray | None"]
 
@@ -120,7 +121,9 @@ def hinge_axis(get: GetJoint, side: str, kind: str, y_upper: np.ndarray, world_l
     else:
         default = lat
     default = default - np.sum(default * y_upper, axis=-1, keepdims=True) * y_upper
-    return bend + HINGE_BLEND * normalize(default)
+    # the default fades out as the bend grows, so a clearly bent limb hinges about its true bend axis
+    fade = np.clip(1.0 - np.linalg.norm(bend, axis=-1, keepdims=True) / HINGE_FADE, 0.0, 1.0) ** 2
+    return bend + HINGE_BLEND * fade * normalize(default)
 
 
 def limb_hint(get: GetJoint, side: str, kind: str, level: int, y: np.ndarray, world_lateral: np.ndarray,
