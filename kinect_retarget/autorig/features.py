@@ -72,6 +72,12 @@ def leaf_candidates(dist: np.ndarray, tol: float = 0.05) -> np.ndarray:
     return np.asarray(keep, dtype=np.int64)
 
 
+def _root_point(vertices: np.ndarray, field: np.ndarray, branch: float) -> np.ndarray:
+    """Centroid of the iso-geodesic ring where a limb meets the body."""
+    band = np.abs(field - branch) < 0.05 * branch
+    return vertices[band].mean(axis=0) if band.any() else vertices[np.argmin(np.abs(field - branch))]
+
+
 def _describe(what: str, tips: int) -> str:
     return f"{what}; found {tips} extremities where a human has five (head, two hands, two feet)"
 
@@ -117,11 +123,13 @@ def find_feature_points(vertices: np.ndarray, graph: MeshGraph) -> FeaturePoints
         raise MeshError("cannot tell the front of the figure from its feet")
     front = fwd / np.linalg.norm(fwd)
     left = np.cross(up, front)  # right-handed: up x front points to the character's left
-    centre = vertices[tips].mean(axis=0)
+    # Left and right are judged at the limbs' roots (shoulders, tops of the thighs), which stay side by
+    # side whatever the pose: in a split or with crossed arms the tips themselves can swap sides.
+    root = {i: _root_point(vertices, fields[i], branch[i]) for i in others}
 
     def split(pair_ids):
         a, b = pair_ids
-        return (a, b) if (vertices[tips[a]] - centre) @ left >= (vertices[tips[b]] - centre) @ left else (b, a)
+        return (a, b) if (root[a] - root[b]) @ left >= 0 else (b, a)
 
     hl, hr = split(hands)
     fl, fr = split(feet)

@@ -1,8 +1,8 @@
 """Name the skeleton: the 20 Kinect v1 joints placed on the geodesic centre lines of the segments.
 
-Each limb joint is the centroid of an iso-geodesic ring around the limb, at a fixed fraction of the limb's
-branch length (tip to where it meets the body); the fractions are human proportions (they hold for
-MakeHuman's base mesh and its posed versions, see benchmarks/bench_autorig.py). Joints inside the torso
+Each joint is the centroid of an iso-geodesic ring around a limb (or the trunk), at a fixed fraction of the
+body's geodesic length; the fractions are human proportions, measured on MakeHuman's base mesh and checked
+on its posed versions (benchmarks/bench_autorig.py). Joints inside the torso
 (hips, shoulder line) come from lines fitted to the limb centre lines, which is the automatic form of the
 paper's shoulder/ankle adjustment (§4.2): instead of stepping a point by hand, it is moved onto the axis of
 the limb it belongs to.
@@ -12,17 +12,17 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.skeletons import KINECT_V1
-from .features import FeaturePoints, branch_lengths
+from .features import FeaturePoints
 
-# Ring positions, as fractions of the branch length from the tip.
-ARM = {"WristLeft": 0.334, "ElbowLeft": 0.70, "ShoulderLeft": 1.06}
-HAND_AT = (0.15, 0.5)    # the palm: half-way from the wrist to the finger ring at 15 %
-LEG = {"FootLeft": 0.183, "AnkleLeft": 0.262, "KneeLeft": 0.655}
-THIGH = (0.72, 1.0)      # the leg's centre line: the thigh (its top is level with the crotch)
-NECK_AT = 1.09           # head field: the ring at the base of the neck
+# Ring positions as fractions of the body's geodesic length L (head top to feet, along the surface). The
+# surface barely stretches when a body moves, so these hold from A-pose to T-pose to a split (the branch
+# lengths of the tree metric do not: the junctions slide with the arms).
+ARM = {"WristLeft": 0.110, "ElbowLeft": 0.222, "ShoulderLeft": 0.335}
+HAND_AT = (0.047, 0.5)   # the palm: half-way from the wrist to the ring across the finger roots
+LEG = {"FootLeft": 0.085, "AnkleLeft": 0.125, "KneeLeft": 0.31}
+THIGH_TOP = 0.46         # foot field: the top of the thigh, level with the crotch
+TORSO = {"ShoulderCenter": 0.193, "Spine": 0.36, "HipCenter": 0.48}  # head field, inside the trunk
 HEAD_DOWN = 0.30         # Head joint: this far from the top toward the neck base
-HIP_CENTRE_AT = 0.97     # head-segment field, fraction of its 99th percentile (the crotch)
-SPINE_AT = 0.58          # Spine: fraction of the way from the neck base to the hip centre
 
 
 def ring_centroid(vertices: np.ndarray, field: np.ndarray, g: float, width: float,
@@ -38,48 +38,51 @@ def ring_centroid(vertices: np.ndarray, field: np.ndarray, g: float, width: floa
     return vertices[near].copy()
 
 
+def body_length(fp: FeaturePoints) -> float:
+    """Geodesic head-top-to-feet length L, the pose-independent size every fraction refers to."""
+    return float(fp.distances[0, fp.vertices[3:5]].mean())
+
+
 def kinect_joints(vertices: np.ndarray, fp: FeaturePoints, segment: np.ndarray, height: float) -> np.ndarray:
     """(20, 3) joint positions in KINECT_V1 order, in mesh coordinates."""
     out = np.zeros((len(KINECT_V1), 3))
     idx = KINECT_V1.index
-    branch = branch_lengths(fp.distances[:, fp.vertices])
+    size = body_length(fp)
     width = 0.006 * height
     head_f = fp.distances[0]
-    in_torso = segment == 0  # the head's domain holds the neck and the whole trunk
+    in_trunk = segment == 0  # the head's domain holds the neck and the whole trunk
 
     for side, s_hand, s_foot in (("Left", 1, 3), ("Right", 2, 4)):
-        f, b = fp.distances[s_hand], branch[s_hand]
+        f = fp.distances[s_hand]
         for name, t in ARM.items():
-            out[idx(name.replace("Left", side))] = ring_centroid(vertices, f, t * b, width)
+            out[idx(name.replace("Left", side))] = ring_centroid(vertices, f, t * size, width)
         wrist = out[idx("Wrist" + side)]
-        out[idx("Hand" + side)] = wrist + HAND_AT[1] * (ring_centroid(vertices, f, HAND_AT[0] * b, width) - wrist)
-        f, b = fp.distances[s_foot], branch[s_foot]
+        palm = ring_centroid(vertices, f, HAND_AT[0] * size, width)
+        out[idx("Hand" + side)] = wrist + HAND_AT[1] * (palm - wrist)
+        f = fp.distances[s_foot]
         for name, t in LEG.items():
-            out[idx(name.replace("Left", side))] = ring_centroid(vertices, f, t * b, width)
+            out[idx(name.replace("Left", side))] = ring_centroid(vertices, f, t * size, width)
+    for name, t in TORSO.items():
+        out[idx(name)] = ring_centroid(vertices, head_f, t * size, width, in_trunk)
 
     top = vertices[fp.vertices[0]]
-    neck = ring_centroid(vertices, head_f, NECK_AT * branch[0], width, in_torso)
-    out[idx("ShoulderCenter")] = neck
+    neck = out[idx("ShoulderCenter")]
     head = top + HEAD_DOWN * (neck - top)
     # Centre it front-to-back on the skull: the middle of a thin slice of the head at that height.
-    in_head = head_f < NECK_AT * branch[0]
     level = (vertices - head) @ fp.up
-    slab = in_head & (np.abs(level) < 0.02 * height)
+    slab = (head_f < TORSO["ShoulderCenter"] * size) & (np.abs(level) < 0.02 * height)
     if slab.any():
         depth = vertices[slab] @ fp.front
         head += fp.front * ((depth.min() + depth.max()) / 2 - head @ fp.front)
     out[idx("Head")] = head
-    g_end = np.percentile(head_f[in_torso], 99)
-    hip_centre = ring_centroid(vertices, head_f, HIP_CENTRE_AT * g_end, width, in_torso)
-    out[idx("HipCenter")] = hip_centre
-    g_neck = NECK_AT * branch[0]
-    out[idx("Spine")] = ring_centroid(vertices, head_f, g_neck + SPINE_AT * (HIP_CENTRE_AT * g_end - g_neck),
-                                      width, in_torso)
-    # Hips: the top of the thigh's centre line, carried along the trunk axis to the hip centre's level
-    # (the femur head sits level with the pelvis centre, whatever the leg does).
+    # Hips: level with the hip centre, as far to each side as the tops of the thighs are (the femur heads
+    # sit level with the pelvis centre whatever the legs do; a flexed thigh's ring is tilted, not moved).
+    hip_centre = out[idx("HipCenter")]
     trunk = neck - hip_centre
     trunk /= max(np.linalg.norm(trunk), 1e-12)
-    for side, s_foot in (("Left", 3), ("Right", 4)):
-        top_of_thigh = ring_centroid(vertices, fp.distances[s_foot], THIGH[1] * branch[s_foot], width)
-        out[idx("Hip" + side)] = top_of_thigh + trunk * ((hip_centre - top_of_thigh) @ trunk)
+    tops = [ring_centroid(vertices, fp.distances[s], THIGH_TOP * size, width) for s in (3, 4)]
+    lateral = (tops[0] - tops[1]) / 2
+    lateral -= trunk * (lateral @ trunk)
+    out[idx("HipLeft")] = hip_centre + lateral
+    out[idx("HipRight")] = hip_centre - lateral
     return out
