@@ -32,6 +32,19 @@ def unpack_11bit(packed, shape: tuple[int, int] = (DEPTH_HEIGHT, DEPTH_WIDTH)) -
     return out.reshape(shape)
 
 
+def blank_byte_ranges(image: np.ndarray, ranges) -> np.ndarray:
+    """Set to no-reading every pixel with any bit in the given (start, end) byte ranges of the packed frame.
+
+    Pixels straddling the edge of a lost packet hold a mix of real and filler bits; they must not pass
+    for readings.
+    """
+    flat = image.reshape(-1)
+    for start, end in ranges:
+        first, last = (8 * start) // 11, (8 * end - 1) // 11
+        flat[first:last + 1] = NO_READING_RAW
+    return image
+
+
 def pack_11bit(image: np.ndarray) -> bytes:
     """uint16 image of 11-bit values (pixel count a multiple of 8) -> packed bytes, MSB first."""
     img = np.asarray(image)

@@ -213,8 +213,8 @@ class EmulatedKinect(usb.backend.IBackend):
         with self._lock:
             self._update_plug()
             if handle.generation != self._generation:
-                raise USBError("No such device (it may have been disconnected)", errno.ENODEV,
-                               LIBUSB_ERROR_NO_DEVICE)
+                raise USBError("No such device (it may have been disconnected)", LIBUSB_ERROR_NO_DEVICE,
+                               errno.ENODEV)
 
     # --- IBackend: enumeration and descriptors -----------------------------------------------------------
     def enumerate_devices(self):
@@ -243,10 +243,10 @@ class EmulatedKinect(usb.backend.IBackend):
         with self._lock:
             self._update_plug()
             if self._generation < 0 or dev not in self.functions:
-                raise USBError("No such device (it may have been disconnected)", errno.ENODEV,
-                               LIBUSB_ERROR_NO_DEVICE)
+                raise USBError("No such device (it may have been disconnected)", LIBUSB_ERROR_NO_DEVICE,
+                               errno.ENODEV)
             if self.faults.access_denied:
-                raise USBError("Access denied (insufficient permissions)", errno.EACCES, LIBUSB_ERROR_ACCESS)
+                raise USBError("Access denied (insufficient permissions)", LIBUSB_ERROR_ACCESS, errno.EACCES)
             return _Handle(dev, self._generation)
 
     def close_device(self, dev_handle):
@@ -262,7 +262,7 @@ class EmulatedKinect(usb.backend.IBackend):
     def set_interface_altsetting(self, dev_handle, intf, altsetting):
         self.check_handle(dev_handle)
         if altsetting >= len(dev_handle.function.interfaces[intf]):
-            raise USBError("Pipe error", errno.EPIPE, LIBUSB_ERROR_PIPE)
+            raise USBError("Pipe error", LIBUSB_ERROR_PIPE, errno.EPIPE)
         dev_handle.alt[intf] = altsetting
 
     def claim_interface(self, dev_handle, intf):
@@ -293,7 +293,7 @@ class EmulatedKinect(usb.backend.IBackend):
                 return self._camera_control(bmRequestType, bRequest, wValue, wIndex, data)
             if fn.kind == "motor":
                 return self._motor_control(bmRequestType, bRequest, wValue, data)
-            raise USBError("Pipe error", errno.EPIPE, LIBUSB_ERROR_PIPE)
+            raise USBError("Pipe error", LIBUSB_ERROR_PIPE, errno.EPIPE)
 
     @staticmethod
     def _fill(data, payload: bytes) -> int:
@@ -306,12 +306,12 @@ class EmulatedKinect(usb.backend.IBackend):
             return self._fill(data, bytes([4, 3, 0x09, 0x04]))
         text = fn.strings().get(index)
         if not text:
-            raise USBError("Pipe error", errno.EPIPE, LIBUSB_ERROR_PIPE)
+            raise USBError("Pipe error", LIBUSB_ERROR_PIPE, errno.EPIPE)
         body = text.encode("utf-16-le")
         return self._fill(data, bytes([2 + len(body), 3]) + body)
 
     def _stall(self):
-        raise USBError("Pipe error", errno.EPIPE, LIBUSB_ERROR_PIPE)
+        raise USBError("Pipe error", LIBUSB_ERROR_PIPE, errno.EPIPE)
 
     def _camera_control(self, rtype, request, value, index, data) -> int:
         if rtype == P.CMD_REQUEST_OUT and request == 0 and value == 0 and index == 0:
@@ -416,5 +416,6 @@ class EmulatedKinect(usb.backend.IBackend):
     def open_iso_pump(self, dev_handle, endpoint: int, transfers: int, packets_per_transfer: int):
         self.check_handle(dev_handle)
         if endpoint != P.DEPTH_ENDPOINT:
-            raise USBError("Pipe error", errno.EPIPE, LIBUSB_ERROR_PIPE)
-        return EmulatedIsoPump(self, dev_handle, endpoint, transfers, packets_per_transfer)
+            raise USBError("Pipe error", LIBUSB_ERROR_PIPE, errno.EPIPE)
+        self.last_pump = EmulatedIsoPump(self, dev_handle, endpoint, transfers, packets_per_transfer)
+        return self.last_pump

@@ -12,7 +12,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from usb.core import USBError
+
 from .depth_unpack import pack_11bit
+from .errors import DeviceGone
 from .protocol import (DEPTH_LAST_PAYLOAD, DEPTH_PACKETS_PER_FRAME, DEPTH_PAYLOAD, PACKET_HEADER_SIZE,
                        TICKS_PER_FRAME, build_packet_header, depth_packet_flag)
 
@@ -94,6 +97,8 @@ class EmulatedIsoPump:
         self._lost_set = self._burst_set(device.faults)
         self._truncate = {(f, p): keep for f, p, keep in device.faults.truncate}
         self.running = False
+        self.faulted: dict[tuple[int, int], int] = {}   # (stream id, frame) -> packets lost or truncated
+        self.overrun_packets = 0                       # lost because the host had no transfer in flight
 
     @staticmethod
     def _burst_set(faults: Faults) -> set[int]:
@@ -116,7 +121,10 @@ class EmulatedIsoPump:
         dev = self._device
         deadline = dev.clock() + timeout
         while True:
-            dev.check_handle(self._handle)       # raises DeviceGone once unplugged
+            try:
+                dev.check_handle(self._handle)
+            except USBError as exc:
+                raise DeviceGone("the Kinect was unplugged") from exc
             stream = dev.depth_stream
             now = dev.clock()
             if stream is not None:
@@ -146,13 +154,19 @@ class EmulatedIsoPump:
             i = self._next
             self._next += 1
             if due > armed:
-                continue                                    # no transfer was in flight: gone for good
+                self.overrun_packets += 1                   # no transfer was in flight: gone for good
+                continue
+            key = (stream.id, i // DEPTH_PACKETS_PER_FRAME)
             if i in self._lost_set or (faults.loss_rate and self._rng.random() < faults.loss_rate):
+                self.faulted[key] = self.faulted.get(key, 0) + 1
                 out.append(None)
                 continue
             packet = stream.packetizer.packet(i)
             keep = self._truncate.get(divmod(i, DEPTH_PACKETS_PER_FRAME))
-            out.append(packet[:keep] if keep is not None else packet)
+            if keep is not None:
+                self.faulted[key] = self.faulted.get(key, 0) + 1
+                packet = packet[:keep]
+            out.append(packet)
         return out
 
 

@@ -14,7 +14,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .protocol import (DEPTH_FRAME_BYTES, DEPTH_LAST_PAYLOAD, DEPTH_PACKETS_PER_FRAME, DEPTH_PAYLOAD,
-                       FLAG_DEPTH_EOF, FLAG_DEPTH_MOF, FLAG_DEPTH_SOF, PACKET_HEADER_SIZE)
+                       FLAG_DEPTH_EOF, FLAG_DEPTH_MOF, FLAG_DEPTH_SOF, PACKET_HEADER_SIZE,
+                       TICKS_PER_FRAME)
 
 MAX_GAP = 5
 MAX_LOST_PER_FRAME = 5
@@ -26,6 +27,7 @@ class AssembledFrame:
     packed: bytearray          # DEPTH_FRAME_BYTES of 11-bit packed depth
     timestamp: int             # device ticks (60 MHz) of the frame's first packet
     lost_packets: int          # packets missing or damaged in this frame (their pixels read 2047)
+    holes: list = field(default_factory=list)   # (start, end) byte ranges of the packed frame never received
 
 
 @dataclass
@@ -50,6 +52,7 @@ class FrameAssembler:
         self._seq = 0              # sequence number expected next
         self._pkt = 0              # position in the frame of the packet expected next
         self._lost = 0
+        self._holes: list = []
         self._timestamp = 0
         self._buf = bytearray()
 
@@ -82,7 +85,12 @@ class FrameAssembler:
         self._seq = seq
         self._pkt = 0
         self._lost = 0
+        self._holes = []
         self._buf = bytearray(_FILL)
+
+    def _hole(self, first_packet: int, count: int) -> None:
+        start = first_packet * DEPTH_PAYLOAD
+        self._holes.append((start, min(start + count * DEPTH_PAYLOAD, DEPTH_FRAME_BYTES)))
 
     def _abandon(self, reason: str) -> None:
         if self._pkt:
@@ -94,13 +102,24 @@ class FrameAssembler:
 
     def _finish(self) -> AssembledFrame | None:
         """End the current frame; the next one starts in a fresh buffer."""
-        buf, lost = self._buf, self._lost
-        self._pkt, self._lost, self._buf = 0, 0, bytearray(_FILL)
+        buf, lost, holes = self._buf, self._lost, self._holes
+        self._pkt, self._lost, self._buf, self._holes = 0, 0, bytearray(_FILL), []
         if lost > self.max_lost:
             self.stats.frames_dropped += 1
             return None
         self.stats.frames += 1
-        return AssembledFrame(buf, self._timestamp, lost)
+        return AssembledFrame(buf, self._timestamp, lost, holes)
+
+    def _skip(self, count: int, seq: int) -> None:
+        """Skip `count` packets at the start of a frame: its start-of-frame (and timestamp) was lost, so the
+        timestamp follows the previous frame's, which is exact because the previous frame just ended."""
+        if count:
+            self._timestamp = (self._timestamp + TICKS_PER_FRAME) & 0xFFFFFFFF
+        self._pkt = count
+        self._lost = count
+        self._seq = seq
+        if count:
+            self._hole(0, count)
 
     def _feed_one(self, p) -> AssembledFrame | None:
         n = len(p)
@@ -124,18 +143,16 @@ class FrameAssembler:
                     return None
                 self._start_frame(seq)
             elif gap >= left:
-                # The frame's tail is missing; the packet belongs to the next frame, whose start is lost
-                # too unless the gap ends exactly at its start.
+                # The frame's tail is missing and this packet belongs to the next frame.
                 self._lost += left
+                self._hole(self._pkt, left)
                 done = self._finish()
-                if gap > left or flag != FLAG_DEPTH_SOF:
-                    self.stats.frames_dropped += 1
-                    self._synced = False
-                    self.stats.resyncs += 1
-                    return done
-                self._start_frame(seq)
+                self._skip(gap - left, seq)
+            elif self._pkt == 0:
+                self._skip(gap, seq)                  # this frame's start-of-frame was lost
             else:
                 self._lost += gap
+                self._hole(self._pkt, gap)
                 self._pkt += gap
                 self._seq = seq
         pkt = self._pkt
@@ -155,11 +172,13 @@ class FrameAssembler:
         if got > size:
             self.stats.packets_bad += 1          # longer than the format allows: keep the 0xFF fill
             self._lost += 1
+            self._holes.append((start, start + size))
         else:
             self._buf[start:start + got] = p[PACKET_HEADER_SIZE:]
             if got < size:
                 self.stats.packets_damaged += 1
                 self._lost += 1
+                self._holes.append((start + got, start + size))
         self._pkt = pkt + 1
         self._seq = (seq + 1) & 0xFF
         if self._pkt == DEPTH_PACKETS_PER_FRAME:

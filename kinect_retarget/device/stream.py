@@ -14,10 +14,11 @@ import time
 from dataclasses import dataclass, replace
 
 import numpy as np
+import usb.core
 
 from .calibration import Calibration
-from .camera import KinectCamera
-from .depth_unpack import unpack_11bit
+from .camera import KinectCamera, is_gone
+from .depth_unpack import blank_byte_ranges, unpack_11bit
 from .discovery import KinectInfo, find_kinect
 from .errors import DeviceGone, DeviceNotFound, KinectError
 from .protocol import DEPTH_ENDPOINT, TICKS_PER_FRAME
@@ -174,6 +175,10 @@ class DepthStream:
                 camera.stop_depth()
             except KinectError:
                 pass
+        except usb.core.USBError as exc:
+            if is_gone(exc):
+                raise DeviceGone("the Kinect was unplugged") from exc
+            raise KinectError(f"USB error: {exc}") from exc
         finally:
             if pump is not None:
                 pump.stop()
@@ -203,6 +208,8 @@ class DepthStream:
 
     def _deliver(self, done, calibration: Calibration, lut: np.ndarray) -> None:
         raw = unpack_11bit(done.packed)
+        if done.holes:
+            blank_byte_ranges(raw, done.holes)
         mm = lut[raw] if self.convert_mm else None
         now = time.monotonic()
         self._recent.append(now)

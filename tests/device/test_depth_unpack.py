@@ -40,3 +40,15 @@ def test_wrong_length_is_a_clear_error():
         unpack_11bit(b"\0" * 1000)
     with pytest.raises(ValueError, match="11-bit"):
         pack_11bit(np.full(8, 4096))
+
+
+def test_blank_byte_ranges_covers_straddling_pixels(real_depth):
+    from kinect_retarget.device.depth_unpack import blank_byte_ranges
+    img = real_depth[1]
+    packed = bytearray(pack_11bit(img))
+    packed[1000:2000] = b"\xff" * 1000                 # as the assembler leaves a lost region
+    raw = blank_byte_ranges(unpack_11bit(bytes(packed)), [(1000, 2000)])
+    k = np.arange(img.size)
+    touched = ((11 * k + 10) >> 3 >= 1000) & ((11 * k) >> 3 < 2000)
+    assert (raw.reshape(-1)[touched] == 2047).all()
+    np.testing.assert_array_equal(raw.reshape(-1)[~touched], img.reshape(-1)[~touched])

@@ -69,13 +69,22 @@ def test_many_small_gaps_add_up_and_drop_the_frame(three_frames):
     assert [f.timestamp for f in frames] == [f.timestamp for f in FrameAssembler().feed(packets)][1:]
 
 
-def test_gap_across_frame_boundary_delivers_the_first_frame_only_if_small(three_frames):
+def test_gap_across_frame_boundary_keeps_both_frames_and_the_timestamp(three_frames):
     images, packets = three_frames
+    clean = FrameAssembler().feed(packets)
     asm = FrameAssembler()
     frames = asm.feed(packets[:PPF - 2] + packets[PPF + 1:])   # last 2 of frame 0 and SOF of frame 1 lost
-    assert len(frames) == 2                                     # frame 0 (2 lost) and frame 2
-    assert frames[0].lost_packets == 2
-    np.testing.assert_array_equal(unpack_11bit(frames[1].packed), images[2])
+    assert [f.lost_packets for f in frames] == [2, 1, 0]
+    assert [f.timestamp for f in frames] == [f.timestamp for f in clean]   # frame 1's estimated exactly
+    np.testing.assert_array_equal(unpack_11bit(frames[2].packed), images[2])
+    assert asm.stats.packets_lost == 3 and asm.stats.frames_dropped == 0
+
+
+def test_lost_start_of_frame_after_a_complete_frame(three_frames):
+    images, packets = three_frames
+    frames = FrameAssembler().feed(packets[:PPF] + packets[PPF + 3:])
+    assert [f.lost_packets for f in frames] == [0, 3, 0]
+    assert (frames[1].timestamp - frames[0].timestamp) & 0xFFFFFFFF == TICKS_PER_FRAME
 
 
 def test_failed_slots_truncated_and_foreign_packets(three_frames):
