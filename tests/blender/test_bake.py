@@ -1,0 +1,147 @@
+"""Round trips through Blender itself: bake a real take, evaluate the rig at keyed frames, compare bones."""
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from kinect_retarget.core.conventions import kinect_to_blender
+from kinect_retarget.core.pipeline import RetargetSettings
+from kinect_retarget.takes import load_take
+
+
+def _bone_world_dir(obj, pb):
+    d = np.array(obj.matrix_world @ pb.tail) - np.array(obj.matrix_world @ pb.head)
+    return d / np.linalg.norm(d)
+
+
+def _check_directions(bpy, obj, motion, take, pairs, every=1):
+    scene = bpy.context.scene
+    p = kinect_to_blender(take.positions[motion.samples])
+    sk = take.skeleton
+    errs = []
+    for i in range(0, len(motion.frames), every):
+        scene.frame_set(int(motion.frames[i]))
+        for bone, (a, b) in pairs.items():
+            src = p[i, sk.index(b)] - p[i, sk.index(a)]
+            src /= np.linalg.norm(src)
+            errs.append(np.degrees(np.arccos(np.clip(_bone_world_dir(obj, obj.pose.bones[bone]) @ src, -1, 1))))
+    return np.array(errs)
+
+
+@pytest.mark.parametrize("take_path", ["kinect_v2/Ges02_balancinghands.csv", "mocap_bvh/131_01.bvh"])
+def test_generated_rig_round_trip(bpy_empty, shared_data, take_path):
+    from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
+    bpy = bpy_empty
+    take = load_take(shared_data / take_path)
+    if take.frame_count > 300:
+        take = take.slice(slice(0, 300))
+    obj = new_generated_rig(bpy.context.scene, take)
+    res = bake_take(obj, take, preset="kinect", settings=RetargetSettings(filter="none"))
+    sk = take.skeleton
+    pairs = {j: (sk.joints[sk.parents[i]], j) for i, j in enumerate(sk.joints) if sk.parents[i] >= 0}
+    errs = _check_directions(bpy, obj, res.motion, take, pairs)
+    assert errs.mean() < 0.05 and errs.max() < 0.5
+    # the Action uses a slot and a channelbag (Blender 5.0 layered actions)
+    ad = obj.animation_data
+    assert ad.action_slot is not None and not hasattr(ad.action, "fcurves")
+    from bpy_extras import anim_utils
+    cb = anim_utils.animdata_get_channelbag_for_assigned_slot(ad)
+    assert len(cb.fcurves) == 4 * len(sk) + 3
+    assert len(cb.fcurves[0].keyframe_points) == len(res.motion.frames)
+    # root head follows the root joint's displacement (n = 1)
+    root = obj.pose.bones[sk.joints[sk.root]]
+    heads = []
+    for f in res.motion.frames[::10]:
+        bpy.context.scene.frame_set(int(f))
+        heads.append(np.array(obj.matrix_world @ root.head))
+    heads = np.array(heads)
+    src = kinect_to_blender(take.positions[res.motion.samples[::10], sk.root])
+    np.testing.assert_allclose(heads - heads[0], src - src[0], atol=1e-4)
+
+
+def test_rig_is_not_edited(bpy_empty, shared_data):
+    from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
+    bpy = bpy_empty
+    take = load_take(shared_data / "kinect_v2" / "Ges04_comehere.csv")
+    obj = new_generated_rig(bpy.context.scene, take)
+    before = [(b.name, tuple(map(tuple, b.matrix_local)), b.use_inherit_rotation, b.parent and b.parent.name)
+              for b in obj.data.bones]
+    bake_take(obj, take, preset="kinect")
+    after = [(b.name, tuple(map(tuple, b.matrix_local)), b.use_inherit_rotation, b.parent and b.parent.name)
+             for b in obj.data.bones]
+    assert before == after
+
+
+def test_rigify_generated_rig_limbs_follow(shared_data, rigify_rig_path):
+    import bpy
+    from kinect_retarget.blender.bake_take import bake_take
+    bpy.ops.wm.open_mainfile(filepath=str(rigify_rig_path))
+    obj = bpy.data.objects["rig"]
+    take = load_take(shared_data / "kinect_v2" / "Ges01_wavehand.csv").slice(slice(0, 40))
+    res = bake_take(obj, take, preset="auto", settings=RetargetSettings(filter="none"))
+    assert res.preset == "rigify"
+    pairs = {f"DEF-{b}.{s[0]}": (f"{a}{s}", f"{c}{s}") for s in ("Left", "Right") for b, a, c in
+             (("upper_arm", "Shoulder", "Elbow"), ("forearm", "Elbow", "Wrist"), ("thigh", "Hip", "Knee"),
+              ("shin", "Knee", "Ankle"))}
+    errs = _check_directions(bpy, obj, res.motion, take, pairs, every=3)
+    assert errs.mean() < 2.0
+    # switched to FK in the action, rig structure untouched
+    assert obj.pose.bones["upper_arm_parent.L"]["IK_FK"] == pytest.approx(1.0)
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+
+
+def test_operator_bakes_onto_active_armature(registered, shared_data):
+    from kinect_retarget.blender.bake_take import new_generated_rig
+    bpy = registered
+    take_path = shared_data / "kinect_v2" / "Ges05_demopoint.csv"
+    obj = new_generated_rig(bpy.context.scene, load_take(take_path))
+    bpy.context.view_layer.objects.active = obj
+    result = bpy.ops.kinect_retarget.bake_take(filepath=str(take_path), preset="kinect", fps=24.0)
+    assert result == {"FINISHED"}
+    assert obj.animation_data.action is not None
+    assert bpy.context.scene.render.fps == 24
+
+
+def test_operator_reports_bad_file_and_leaves_scene(registered, tmp_path):
+    from kinect_retarget.blender.bake_take import new_generated_rig
+    from kinect_retarget.core.skeletons import KINECT_V1
+    bpy = registered
+    bad = tmp_path / "broken.csv"
+    bad.write_text("hello,world\n1,2\n")
+    obj = new_generated_rig(bpy.context.scene, _tiny_take(KINECT_V1))
+    bpy.context.view_layer.objects.active = obj
+    with pytest.raises(RuntimeError, match="broken.csv"):
+        bpy.ops.kinect_retarget.bake_take(filepath=str(bad))
+    assert obj.animation_data is None and len(bpy.data.actions) == 0
+
+
+def test_operator_refuses_non_armature(registered):
+    bpy = registered
+    mesh = bpy.data.objects.new("Cube", bpy.data.meshes.new("Cube"))
+    bpy.context.scene.collection.objects.link(mesh)
+    bpy.context.view_layer.objects.active = mesh
+    assert not bpy.ops.kinect_retarget.bake_take.poll()
+
+
+def _tiny_take(skeleton):
+    from kinect_retarget.core.kinect_rig_layout import rest_joint_positions
+    from kinect_retarget.core.conventions import blender_to_kinect
+    from kinect_retarget.core.take import Take
+    pos = blender_to_kinect(rest_joint_positions(skeleton, np.full(len(skeleton), 0.3)))
+    return Take(skeleton, np.repeat(pos[None], 3, 0), np.full((3, len(skeleton)), 2), np.arange(3) / 30, 30.0)
+
+
+def test_cli_bake_and_info(shared_data, tmp_path):
+    take = shared_data / "mocap_bvh" / "131_03.bvh"
+    out = tmp_path / "hop.blend"
+    info = subprocess.run([sys.executable, "-m", "kinect_retarget", "info", str(take), "--json"],
+                          capture_output=True, text=True, check=True)
+    assert '"frames": 1102' in info.stdout and '"skeleton": "kinect_v1"' in info.stdout
+    r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(take), "--out", str(out),
+                        "--fps", "30", "--filter", "none"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert out.is_file() and '"preset": "kinect"' in r.stdout
+    bad = subprocess.run([sys.executable, "-m", "kinect_retarget", "info", str(tmp_path / "missing.csv")],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "missing.csv" in bad.stderr
