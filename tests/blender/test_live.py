@@ -1,0 +1,216 @@
+"""Live in Blender, headless: the same pump the timer runs, on a real armature (bpy 5.0.1 wheel)."""
+from __future__ import annotations
+
+import os
+import threading
+import time
+
+import bpy
+import numpy as np
+import pytest
+
+import kinect_retarget
+from kinect_retarget.blender import live
+from kinect_retarget.blender.kinect_rig import build_kinect_rig
+from kinect_retarget.core.kinect_rig_layout import median_segment_lengths
+from kinect_retarget.core.quat import angle_between
+from kinect_retarget.core.skeletons import KINECT_V2
+from kinect_retarget.core.take import Take
+from kinect_retarget.live.calibration import PROPERTY as CALIBRATION
+from kinect_retarget.sources.base import FrameSource
+from kinect_retarget.takes import krtake
+
+
+def _csv_take(path, frames=None) -> Take:
+    a = np.array([[float(v) for v in line.strip().split(",") if v] for line in open(path) if line.strip()])
+    a = a[:frames] if frames else a
+    block = a[:, 1:].reshape(len(a), 25, 4)
+    return Take(KINECT_V2, np.round(block[..., :3], 5), block[..., 3].astype(np.uint8), (a[:, 0] - a[0, 0]) / 1e7,
+                30.0)
+
+
+@pytest.fixture
+def registered():
+    kinect_retarget.register()
+    yield
+    live.stop_live(bake=False)
+    kinect_retarget.unregister()
+
+
+@pytest.fixture
+def scene_with_rig(registered, shared_data, tmp_path):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    take = _csv_take(shared_data / "kinect_v2" / "Ges01_wavehand.csv", frames=90)
+    path = tmp_path / "wave.krtake"
+    krtake.write(path, take)
+    scene = bpy.context.scene
+    obj = build_kinect_rig(scene, KINECT_V2, median_segment_lengths(take), "KinectRig")
+    bpy.context.view_layer.objects.active = obj
+    s = scene.kinect_retarget
+    s.initialised = True
+    s.source, s.take_path, s.speed, s.loop = "TAKE", str(path), 3.0, False
+    s.armature = obj
+    s.record_dir = str(tmp_path / "rec")
+    s.play_on_record = False
+    return scene, obj, take, path
+
+
+def run_live(seconds=10.0):
+    end = time.perf_counter() + seconds
+    while live.pump_live() and time.perf_counter() < end:
+        time.sleep(0.003)
+
+
+def pose_quats(obj, names):
+    return np.array([obj.pose.bones[n].rotation_quaternion[:] for n in names])
+
+
+def test_live_poses_rig_records_and_bakes_at_timeline_frames(scene_with_rig):
+    scene, obj, take, _ = scene_with_rig
+    scene.frame_current = 40
+    rest = pose_quats(obj, [b.name for b in obj.pose.bones])
+    seen = []
+    c = live.start_live(bpy.context, use_timer=False)
+    apply = c.session.apply
+    c.session.apply = lambda pose: (apply(pose), seen.append((pose, pose_quats(obj, pose.bone_names))))
+    c.start_recording(bpy.context)
+    rec_path = c.recording["path"]
+    run_live()
+    assert live.controller() is None, "a non-looping take ends live by itself"
+    st = live.status()
+    assert st["error"] is None and st["stats"]["received"] == take.frame_count == st["stats"]["recorded"]
+    assert len(seen) > 10
+    # the applied values are what Blender holds (float32)
+    pose, held = seen[-1]
+    assert np.degrees(angle_between(held, pose.quats)).max() < 1e-3
+    assert not np.allclose(held, rest[: len(held)])
+    # recording kept and baked: keys from the frame where recording started, at the scene rate
+    assert os.path.isfile(rec_path) and krtake.read(rec_path).frame_count == take.frame_count
+    action = obj.animation_data.action
+    assert action is not None and action.name.startswith("KinectRig_live_")
+    fc = action.layers[0].strips[0].channelbag(action.slots[0]).fcurves
+    curve = fc.find('pose.bones["SpineMid"].rotation_quaternion', index=0)
+    keys = np.array([k.co[0] for k in curve.keyframe_points])
+    assert keys[0] == 40
+    rec = krtake.read(rec_path)
+    fps = scene.render.fps / scene.render.fps_base
+    assert keys[-1] == 40 + round((rec.times[-1] - rec.times[0]) * fps)
+    # live equals baked: each applied pose is the action's value at that sample's frame
+    names = seen[0][0].bone_names
+    for pose, held in seen[:: max(1, len(seen) // 8)]:
+        i = int(np.argmin(np.abs(rec.times - pose.time)))
+        frame = 40 + round((rec.times[i] - rec.times[0]) * fps)
+        if i and frame == 40 + round((rec.times[i - 1] - rec.times[0]) * fps):
+            continue  # another sample owns this frame's key
+        scene.frame_set(frame)
+        assert np.degrees(angle_between(pose_quats(obj, names), pose.quats)).max() < 1e-3
+
+
+def test_stop_without_recording_restores_the_pose(scene_with_rig):
+    scene, obj, take, _ = scene_with_rig
+    obj.pose.bones["ElbowLeft"].rotation_quaternion = (0.9, 0.1, 0.3, 0.0)
+    before = pose_quats(obj, [b.name for b in obj.pose.bones])
+    scene.kinect_retarget.loop = True
+    live.start_live(bpy.context, use_timer=False)
+    for _ in range(40):
+        live.pump_live()
+        time.sleep(0.005)
+    assert not np.allclose(pose_quats(obj, [b.name for b in obj.pose.bones]), before, atol=1e-4)
+    bpy.ops.kinect_retarget.live_stop()
+    assert live.controller() is None
+    np.testing.assert_allclose(pose_quats(obj, [b.name for b in obj.pose.bones]), before, atol=1e-6)
+    assert obj.animation_data is None or obj.animation_data.action is None
+    assert not [t for t in threading.enumerate() if t.name.startswith("kinect_retarget")]
+
+
+def test_file_vanishing_shows_error_stops_and_keeps_recording(scene_with_rig):
+    scene, obj, take, path = scene_with_rig
+    scene.kinect_retarget.speed = 1.0
+    c = live.start_live(bpy.context, use_timer=False)
+    c.start_recording(bpy.context)
+    rec_path = c.recording["path"]
+    for _ in range(30):
+        live.pump_live()
+        time.sleep(0.01)
+    os.remove(path)
+    run_live()
+    st = live.status()
+    assert st["state"] == "error" and "vanished" in st["error"] and str(path) in st["error"]
+    kept = krtake.read(rec_path)
+    assert kept.frame_count >= 5
+    assert obj.animation_data.action is not None  # what was recorded got baked too
+    assert not [t for t in threading.enumerate() if t.name.startswith("kinect_retarget") and t.is_alive()]
+
+
+class _Scripted(FrameSource):
+    kind = "scripted"
+
+    def __init__(self, take, nan_at=None, untracked_from=None):
+        super().__init__(take.skeleton, 30.0)
+        self.take, self.nan_at, self.untracked_from = take, nan_at, untracked_from
+
+    def _run(self):
+        for i in range(self.take.frame_count):
+            if not self._sleep(0.004):
+                return
+            pos, st = self.take.positions[i].copy(), self.take.states[i].copy()
+            if i == self.nan_at:
+                pos[5] = np.nan
+            if self.untracked_from is not None and i >= self.untracked_from:
+                st[:] = 0
+            self._emit(pos, st, i / 30.0, where=f" frame {i}")
+
+
+@pytest.mark.parametrize("fault, expect", [({"nan_at": 25}, "NaN"), ({"untracked_from": 20}, "no tracked joints")])
+def test_bad_frames_stop_live_with_the_reason(scene_with_rig, fault, expect):
+    scene, obj, take, _ = scene_with_rig
+    bpy.context.preferences.addons  # preferences may be absent when registered as a plain module
+    c = live.start_live(bpy.context, source=_Scripted(take, **fault), use_timer=False)
+    c.session.lost_tracking_timeout = 0.3
+    c.start_recording(bpy.context)
+    rec_path = c.recording["path"]
+    run_live()
+    st = live.status()
+    assert st["state"] == "error" and expect in st["error"]
+    assert krtake.read(rec_path).frame_count >= 20
+
+
+def test_calibration_is_stored_on_the_rig_and_survives_save_and_load(scene_with_rig, tmp_path):
+    scene, obj, take, _ = scene_with_rig
+    scene.kinect_retarget.loop = True
+    c = live.start_live(bpy.context, use_timer=False)
+    c.calibrate(0.15)
+    end = time.perf_counter() + 5
+    while c.session.calibrating and time.perf_counter() < end:
+        live.pump_live()
+        time.sleep(0.005)
+    live.stop_live(bake=False)
+    stored = obj.get(CALIBRATION)
+    assert stored and '"root_scale": 1.0' in stored  # the generated rig keeps n = 1
+    blend = str(tmp_path / "cal.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=blend)
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.wm.open_mainfile(filepath=blend)
+    assert bpy.data.objects["KinectRig"].get(CALIBRATION) == stored
+
+
+def test_loading_a_file_stops_live(scene_with_rig, tmp_path):
+    scene, obj, take, _ = scene_with_rig
+    scene.kinect_retarget.loop = True
+    blend = str(tmp_path / "other.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=blend)
+    live.start_live(bpy.context, use_timer=True)
+    live.pump_live()
+    bpy.ops.wm.open_mainfile(filepath=blend)
+    assert live.controller() is None
+    assert not bpy.app.timers.is_registered(live._timer)
+    assert not [t for t in threading.enumerate() if t.name.startswith("kinect_retarget") and t.is_alive()]
+
+
+def test_live_operators_push_no_undo_steps_and_show_in_search(registered):
+    from kinect_retarget.blender.live import CLASSES
+    for cls in CLASSES:
+        assert "UNDO" not in cls.bl_options, cls.bl_idname
+        assert cls.bl_idname.startswith("kinect_retarget.") and cls.__doc__  # F3 search shows label + tooltip
+        assert "INTERNAL" not in cls.bl_options
+        assert getattr(bpy.ops.kinect_retarget, cls.bl_idname.split(".")[1]).get_rna_type() is not None
