@@ -72,8 +72,14 @@ class LiftResult:
     problems: list[str]
 
 
-def lift(tracks: Tracks2D, settings: LiftSettings | None = None) -> LiftResult:
+def lift(tracks: Tracks2D, settings: LiftSettings | None = None, *, scale: np.ndarray | None = None,
+         signs: np.ndarray | None = None) -> LiftResult:
+    """Lift 2D tracks to a Kinect v1 take in the video camera's space (Kinect camera-space axes).
+
+    scale (F,) px/m and signs (F, J) override the estimates (evaluation with known ground truth)."""
     st = settings or LiftSettings()
+    if st.scale not in ("paper", "envelope"):
+        raise LiftError(f"unknown scale method {st.scale!r} (envelope, paper)")
     problems = list(tracks.problems)
     lengths = np.asarray(st.lengths, dtype=np.float64) if st.lengths is not None else lengths_from_height(st.height_m)
     if lengths.shape != (len(SK),) or np.any(lengths[PARENTS >= 0] <= 0):
@@ -84,6 +90,7 @@ def lift(tracks: Tracks2D, settings: LiftSettings | None = None) -> LiftResult:
     have = present | filled
     noise_px = jitter_px(uv, present & ~filled) if st.noise_px is None else st.noise_px
     uv = gaussian_smooth(uv, have[..., None], tracks.times, st.smooth_2d_s)
+    sigma_px = noise_px * _smoothing_gain(tracks.times, st.smooth_2d_s) if st.noise_aware else 0.0
     body = have[:, SK.root]
     for i in np.flatnonzero(~body & have.any(axis=1)):
         problems.append(f"{tracks.source}: {tracks.frame_label(i)}: hips not visible, frame left untracked")
@@ -93,39 +100,38 @@ def lift(tracks: Tracks2D, settings: LiftSettings | None = None) -> LiftResult:
     xy = np.stack([-(uv[..., 0] - cam.cx), -(uv[..., 1] - cam.cy)], axis=-1)
     bone_ok = have & have[:, np.maximum(PARENTS, 0)] & (PARENTS >= 0)
     d_vec = xy - xy[:, np.maximum(PARENTS, 0)]
-    d_px = np.linalg.norm(d_vec, axis=-1)
-    scale_idx = np.array([SK.index(n) for n in SCALE_BONES])
-    usable = measured[:, scale_idx] & measured[:, PARENTS[scale_idx]] & body[:, None]
-    s_min = scale_lower_bound(d_px[:, scale_idx], lengths[scale_idx], usable)
-    s_min = fill_missing(s_min, tracks.source or "2D tracks")
-    if st.scale == "paper":
-        s = scale_paper(d_px[:, scale_idx] * usable, lengths[scale_idx], s_min)
-    else:
-        ratios = np.where(usable, smooth_lengths(d_px[:, scale_idx], usable) / lengths[scale_idx], np.nan)
-        s = scale_envelope(ratios, tracks.times, st.scale_window_s, st.scale_quantile)
-    if st.scale not in ("paper", "envelope"):
-        raise LiftError(f"unknown scale method {st.scale!r} (envelope, paper)")
+    s = _scale(tracks, st, d_vec, measured, body, lengths) if scale is None else np.asarray(scale, float)
 
+    # Scaled orthographic depth magnitudes (paper §3.2, noise-aware) decide the signs ...
     dxy = np.where(bone_ok[..., None], d_vec / s[:, None, None], 0.0)
     c_obs = np.linalg.norm(dxy, axis=-1) / np.maximum(lengths, 1e-9)
-    if st.noise_aware:  # 2D jitter left after smoothing, as foreshortening noise of each bone
-        sigma_c = np.sqrt(2.0) * noise_px * _smoothing_gain(tracks.times, st.smooth_2d_s) / (s[:, None] * np.maximum(lengths, 1e-9))
-    else:
-        sigma_c = 0.0
-    dz = np.where(bone_ok, lengths * depth_magnitude(c_obs, sigma_c), 0.0)
-    travel = _travel_direction(xy[:, SK.root] / s[:, None], cam.focal_px / s, tracks.times, body)
-    signs = choose_signs(dxy, dz, tracks.times, body, travel, st.priors, st.signs)
-
-    signed_dz = gaussian_smooth(signs * dz, bone_ok & body[:, None], tracks.times, st.smooth_depth_s)
-    positions = _place_joints(uv, have, s, signed_dz, lengths, cam, st.focal_px is not None)
+    dz = np.where(bone_ok, lengths * depth_magnitude(c_obs, np.sqrt(2.0) * sigma_px / (s[:, None] * np.maximum(lengths, 1e-9))), 0.0)
+    if signs is None:
+        travel = _travel_direction(xy[:, SK.root] / s[:, None], cam.focal_px / s, tracks.times, body)
+        signs = choose_signs(dxy, dz, tracks.times, body, travel, st.priors, st.signs)
+    # ... and the joints are placed with the camera model.
+    positions = _place_joints(uv, have, body, s, signs, lengths, cam, st.focal_px is not None, sigma_px,
+                              tracks.times, st.smooth_depth_s)
     states = np.where(measured & ~filled, TRACKED, INFERRED).astype(np.uint8)
     states[~body] = NOT_TRACKED
     positions[~body] = np.nan
-    rate = nominal_rate(tracks.times)
     meta = {"lifted_from": tracks.source, "focal_px": cam.focal_px, "focal_known": cam.focal_known,
-            "scale_method": st.scale, "sign_method": st.signs, "problems": len(problems)}
-    take = Take(SK, positions, states, tracks.times, rate, "lift", meta)
+            "scale_method": st.scale, "sign_method": st.signs, "noise_px": round(noise_px, 3),
+            "problems": len(problems)}
+    take = Take(SK, positions, states, tracks.times, nominal_rate(tracks.times), "lift", meta)
     return LiftResult(take, s, signs, cam, problems)
+
+
+def _scale(tracks, st: LiftSettings, d_vec, measured, body, lengths) -> np.ndarray:
+    """Per-frame s (px/m) from the long bones measured in both ends (eq. 2, then eq. 3 or the envelope)."""
+    idx = np.array([SK.index(n) for n in SCALE_BONES])
+    d_px = np.linalg.norm(d_vec[:, idx], axis=-1)
+    usable = measured[:, idx] & measured[:, PARENTS[idx]] & body[:, None]
+    s_min = fill_missing(scale_lower_bound(d_px, lengths[idx], usable), tracks.source or "2D tracks")
+    if st.scale == "paper":
+        return scale_paper(d_px * usable, lengths[idx], s_min)
+    ratios = np.where(usable, smooth_lengths(d_px, usable) / lengths[idx], np.nan)
+    return scale_envelope(ratios, tracks.times, st.scale_window_s, st.scale_quantile)
 
 
 def _smoothing_gain(times: np.ndarray, sigma_s: float) -> float:
@@ -188,10 +194,16 @@ _DEFAULT_DIR.update({"Spine": _UP, "ShoulderCenter": _UP, "Head": _UP,
                      "HipLeft": np.array([-0.9, -0.45, 0]), "HipRight": np.array([0.9, -0.45, 0])})
 
 
-def _place_joints(uv, have, s, signed_dz, lengths, cam: Camera, perspective: bool) -> np.ndarray:
-    """Walk the tree from the pelvis: each joint at its parent's depth plus its bone's signed depth offset,
-    on its image ray (perspective) or its orthographic line, so it reprojects onto its 2D track exactly.
-    Joints never seen hang from their parent in a default direction."""
+def _place_joints(uv, have, body, s, signs, lengths, cam: Camera, perspective: bool, sigma_px: float,
+                  times, smooth_s: float) -> np.ndarray:
+    """Walk the tree from the pelvis, putting each joint on its image ray (perspective) or orthographic
+    line at its bone's length from the parent, on the chosen depth side, so it reprojects onto its track.
+
+    With h the parent's distance from that line, the joint sits sqrt(L^2 - h^2) along it from the foot of
+    the perpendicular (the perspective form of dz = sqrt(L^2 - d^2/s^2)); with 2D noise we use the
+    noise-aware magnitude (depth.py) and smooth the signed offset over time. Joints never seen hang from
+    their parent in a default direction.
+    """
     f = uv.shape[0]
     pos = np.full((f, len(SK), 3), np.nan)
     z_root = cam.focal_px / s
@@ -201,13 +213,23 @@ def _place_joints(uv, have, s, signed_dz, lengths, cam: Camera, perspective: boo
     fwd = None
     for j in ORDER[1:]:
         parent = pos[:, PARENTS[j]]
-        z = parent[:, 2] + signed_dz[:, j]
-        xy_z = z if perspective else z_root  # orthographic: X, Y from the root's depth
-        on_ray = np.concatenate([rays[:, j, :2] * xy_z[:, None], z[:, None]], axis=1)
+        if perspective:
+            o, d = np.zeros((f, 3)), rays[:, j]
+        else:  # orthographic: the line through the joint's (X, Y) at the root's depth, along the optical axis
+            o = np.concatenate([rays[:, j, :2] * z_root[:, None], np.zeros((f, 1))], axis=1)
+            d = np.tile([0.0, 0.0, 1.0], (f, 1))
+        dn = np.linalg.norm(d, axis=1)
+        u = d / dn[:, None]
+        foot = o + np.sum((parent - o) * u, axis=1)[:, None] * u  # nearest point of the line to the parent
+        c = np.linalg.norm(parent - foot, axis=1) / lengths[j]
+        depth_px = cam.focal_px / np.maximum(foot[:, 2], 1e-6)  # pixels per metre at the joint
+        mag = lengths[j] * depth_magnitude(c, np.sqrt(2.0) * sigma_px / (depth_px * lengths[j]))
+        along = gaussian_smooth(signs[:, j] * mag, have[:, j] & body, times, smooth_s)
+        on_line = foot + along[:, None] * u
         if fwd is None and SK.joints[j].startswith("Foot"):
             fwd = _forward(pos)
         guessed = parent + lengths[j] * _default_direction(SK.joints[j], pos, PARENTS[j], fwd)
-        pos[:, j] = np.where(have[:, j, None], on_ray, guessed)
+        pos[:, j] = np.where(have[:, j, None], on_line, guessed)
     return pos
 
 

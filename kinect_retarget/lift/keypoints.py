@@ -1,0 +1,39 @@
+"""Shared last step of the keypoint readers: drop impossible points (naming them) and map onto Kinect v1."""
+from __future__ import annotations
+
+import numpy as np
+
+from .schemes import SYNTHETIC_V1
+from .tracks2d import Tracks2D, combine
+
+MAX_NOTES = 12  # problems listed one by one before they are summarised
+
+
+def outside_image(uv: np.ndarray, conf: np.ndarray, size, names, source: str, labels) -> tuple[np.ndarray, list[str]]:
+    """Zero the confidence of keypoints outside the image (a small margin allowed) and describe them."""
+    if size is None:
+        return conf, []
+    w, h = size
+    margin = 0.02 * max(w, h)
+    bad = (conf > 0) & ((uv[..., 0] < -margin) | (uv[..., 0] > w + margin) |
+                        (uv[..., 1] < -margin) | (uv[..., 1] > h + margin))
+    notes = []
+    for f, k in zip(*np.nonzero(bad)):
+        if len(notes) == MAX_NOTES:
+            notes.append(f"{source}: ... {int(bad.sum()) - MAX_NOTES} more keypoints outside the image ignored")
+            break
+        notes.append(f"{source}: {labels[f]}: {names[k]} at ({uv[f, k, 0]:.0f}, {uv[f, k, 1]:.0f}) px is "
+                     f"outside the {w:.0f}x{h:.0f} image; ignored")
+    return np.where(bad, 0.0, conf), notes
+
+
+def to_tracks(uv, conf, recipe, times, size, source, problems, frame_numbers) -> Tracks2D:
+    out_uv, out_c, inferred = combine(uv, conf, recipe, synthetic=SYNTHETIC_V1)
+    return Tracks2D(out_uv, out_c, times, size, source, inferred, problems, frame_numbers=frame_numbers)
+
+
+def summarise(notes: list[str], source: str, what: str) -> list[str]:
+    """Keep the first MAX_NOTES notes of one kind and count the rest."""
+    if len(notes) <= MAX_NOTES:
+        return notes
+    return notes[:MAX_NOTES] + [f"{source}: ... and {len(notes) - MAX_NOTES} more {what}"]
