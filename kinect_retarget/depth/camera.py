@@ -1,7 +1,8 @@
 """Kinect v1 depth camera model: intrinsics, raw 11-bit disparity <-> millimetres.
 
-The raw-to-metre fit z = 1 / (raw * -0.0030711016 + 3.3309495161) is the common libfreenect fit (data
-README §5a); raw 2047 means "no reading", as does 0 mm.
+Raw values convert with the USB driver's own formula and default calibration (device/calibration.py), so
+rendered frames streamed through the emulated Kinect decode to the same millimetres; raw 2047 means "no
+reading", as does 0 mm.
 """
 from __future__ import annotations
 
@@ -9,7 +10,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-RAW_A, RAW_B = -0.0030711016, 3.3309495161
+from ..device.calibration import Calibration
+
+DEFAULT_CALIBRATION = Calibration()
 NO_READING_RAW = 2047
 WIDTH, HEIGHT = 640, 480
 
@@ -25,19 +28,20 @@ class DepthCamera:
     projector_x: float = -0.075  # projector position along Kinect X (it sits on the sensor's right)
 
 
-def raw_to_metres(raw: np.ndarray) -> np.ndarray:
-    raw = np.asarray(raw, dtype=np.float64)
-    denom = raw * RAW_A + RAW_B
-    ok = (raw < NO_READING_RAW) & (denom > 0)
-    return np.where(ok, 1.0 / np.where(ok, denom, 1.0), 0.0)
+def raw_to_metres(raw: np.ndarray, calibration: Calibration = DEFAULT_CALIBRATION) -> np.ndarray:
+    """Depth in metres for raw 11-bit values (0 where there is no reading), the driver's formula."""
+    return calibration.raw_to_mm_table()[np.minimum(np.asarray(raw, dtype=np.int64), NO_READING_RAW)] * 0.001
 
 
-def metres_to_raw(z: np.ndarray) -> np.ndarray:
-    """Continuous raw disparity for depth z (metres); callers round and clip it."""
-    z = np.asarray(z, dtype=np.float64)
-    return (1.0 / np.maximum(z, 1e-6) - RAW_B) / RAW_A
+def metres_to_raw(z: np.ndarray, calibration: Calibration = DEFAULT_CALIBRATION) -> np.ndarray:
+    """Continuous raw disparity for depth z (metres), the inverse of the driver's formula; callers round
+    and clip it (the rounding is the device's disparity quantisation)."""
+    c = calibration
+    d = np.maximum(np.asarray(z, dtype=np.float64), 1e-3) * 100.0   # the table's mm / 10
+    m = (d - c.reference_distance) * c.dcmos_emitter_dist / d       # offset on the reference plane
+    return 4.0 * (m / c.reference_pixel_size + 0.375) + 4.0 * c.const_shift
 
 
-def raw_to_mm(raw: np.ndarray) -> np.ndarray:
-    """uint16 millimetres, 0 where there is no reading."""
-    return np.round(raw_to_metres(raw) * 1000.0).astype(np.uint16)
+def raw_to_mm(raw: np.ndarray, calibration: Calibration = DEFAULT_CALIBRATION) -> np.ndarray:
+    """uint16 millimetres, 0 where there is no reading (same table as the USB driver)."""
+    return calibration.to_mm(np.asarray(raw, dtype=np.int64))

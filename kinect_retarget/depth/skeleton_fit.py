@@ -103,17 +103,24 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     if seed is None:
         return None
     d0 = graph.distances(np.array([seed]))
-    patch = xyz[d0 < 0.12 * H]
+    patch = xyz[d0 < 0.1 * H]
     if len(patch) < 10:
         return None
-    centre = patch.mean(axis=0)
+    centre = np.median(patch, axis=0)  # the median ignores a hanging arm caught at the patch's edge
     _, _, vt = np.linalg.svd(patch - centre, full_matrices=False)
     axis = vt[0] if vt[0] @ up > 0 else -vt[0]
     axis = _unit(0.5 * axis + 0.5 * up) if axis @ up > 0.5 else up  # crouched/odd patch: trust gravity
     view = _unit(centre)
-    lat = _unit(np.cross(view, axis))  # points to the performer's left when facing the sensor
-    if prev_lateral is not None and lat @ prev_lateral < 0:
-        lat = -lat
+    facing = vt[2] if vt[2] @ view < 0 else -vt[2]  # the chest's normal, toward the sensor
+    facing = _unit(facing - (facing @ axis) * axis)
+    if facing @ -view < 0.3:  # seen nearly edge-on: the normal is unreliable, assume facing the sensor
+        facing = _unit(-view - (-view @ axis) * axis)
+    lat = _unit(np.cross(axis, facing))  # points to the performer's left
+    if prev_lateral is not None:
+        if lat @ prev_lateral < 0:
+            lat = -lat
+        lat = _unit(0.5 * lat + 0.5 * prev_lateral)
+        lat = _unit(lat - (lat @ axis) * axis)
     inside = lambda name: view * bm.DEPTH_INSIDE[name]
     # --- extremities ---------------------------------------------------------------------------------
     extrema = geodesic_extrema(graph, d0, count=6, min_distance=0.15 * H)
@@ -121,10 +128,7 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     for r, c, dist in extrema:
         p = xyz[r, c]
         cand.append(((r, c), p, dist, (p - centre) @ axis, (p - centre) @ lat))
-    heady = [e for e in cand if e[3] > -0.05 * H and abs(e[4]) < 0.15 * H]
-    if prev_head_top is not None:
-        near = [e for e in heady if np.linalg.norm(e[1] - prev_head_top) < 0.25]
-        heady = near or heady
+    heady = [e for e in cand if (e[1] - centre) @ up > 0 and abs(e[4]) < 0.15 * H]
     head = max(heady, key=lambda e: e[1] @ up, default=None)
     # the head top pins the torso along its axis (the torso patch alone drifts along the body)
     if head is not None:

@@ -101,6 +101,7 @@ class SkeletonTracker:
             self._lose(ts)
             return self._none("person found but no skeleton fitted")
         pos, st = fit.positions, fit.states
+        self.last_grid = grid
         self._calibrate(person, fit, up)
         if self._prev is not None and self.settings.smoothing > 0:
             step = np.linalg.norm(pos - self._prev, axis=1, keepdims=True)
@@ -135,7 +136,9 @@ class SkeletonTracker:
         if not {"head", "FootLeft", "FootRight"} <= set(labels):
             return
         feet_h = [self.floor.height(labels[k]) for k in ("FootLeft", "FootRight")]
-        top = self.floor.height(labels["head"])
+        pts = self.last_grid.xyz[person.mask]
+        near_head = pts[np.linalg.norm(pts - labels["head"], axis=1) < 0.2]
+        top = float(np.max(self.floor.height(near_head))) if len(near_head) else self.floor.height(labels["head"])
         if max(feet_h) > 0.15 or not 1.2 < top < 2.2:  # not standing on the floor
             return
         self.calibration.update(top, float(self.floor.height(fit.torso_centre)))

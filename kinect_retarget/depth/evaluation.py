@@ -1,0 +1,49 @@
+"""Scores for a tracked sequence against ground truth (used by the benchmark and the tests)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.skeletons import KINECT_V1, NOT_TRACKED, TRACKED
+
+_PAIRS = [(KINECT_V1.index(f"{p}Left"), KINECT_V1.index(f"{p}Right")) for p in ("Hand", "Foot", "Elbow", "Knee")]
+
+
+@dataclass
+class Score:
+    mean_error: float            # metres, over frames where the performer is present and a skeleton was output
+    per_joint: np.ndarray        # (20,) metres
+    within_or_flagged: float     # fraction of joint samples within 15 cm, or reported inferred/untracked
+    tracked_error: float         # mean error of joints reported TRACKED
+    longest_swap: int            # longest run of frames with a left/right pair swapped
+    swaps_over_3: int            # number of swap runs longer than 3 frames
+    coverage: float              # fraction of present frames with a skeleton
+    nan_frames: int
+
+
+def score(positions: np.ndarray, states: np.ndarray, gt: np.ndarray, present: np.ndarray) -> Score:
+    has = np.any(states != NOT_TRACKED, axis=1) & present
+    nan_frames = int(np.sum(~np.all(np.isfinite(positions), axis=(1, 2))))
+    err = np.linalg.norm(positions - gt, axis=-1)
+    e = err[has]
+    s = states[has]
+    ok = (e <= 0.15) | (s != TRACKED)
+    swapped = np.zeros(len(positions), bool)
+    for l, r in _PAIRS:
+        straight = err[:, l] + err[:, r]
+        crossed = np.linalg.norm(positions[:, l] - gt[:, r], axis=-1) + np.linalg.norm(positions[:, r] - gt[:, l], axis=-1)
+        sep = np.linalg.norm(gt[:, l] - gt[:, r], axis=-1)
+        swapped |= (crossed + 0.1 < straight) & (sep > 0.15) & has
+    runs, run = [], 0
+    for f in swapped:
+        run = run + 1 if f else 0
+        if run == 1:
+            runs.append(0)
+        if run:
+            runs[-1] = run
+    return Score(float(e.mean()) if e.size else float("nan"), e.mean(axis=0) if e.size else np.full(20, np.nan),
+                 float(ok.mean()) if ok.size else 0.0,
+                 float(e[s == TRACKED].mean()) if np.any(s == TRACKED) else float("nan"),
+                 max(runs, default=0), sum(r > 3 for r in runs), float(has.sum() / max(present.sum(), 1)),
+                 nan_frames)
