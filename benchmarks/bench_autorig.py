@@ -1,0 +1,146 @@
+"""Auto-rig (paper 003) on MakeHuman's base mesh: joint accuracy at rest and posed, symmetry, inside-ness,
+time, and the paper's table 3 (skeleton points per level against a Reeb-graph baseline). Prints figures.
+
+    .venv/bin/python benchmarks/bench_autorig.py [--frames N]
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+DATA = REPO.parent / "shared" / "data"
+
+from kinect_retarget.autorig import autorig, load_mesh  # noqa: E402
+from kinect_retarget.autorig.evaluation import (joint_errors, load_makehuman, pose_body,  # noqa: E402
+                                                reference_joints, rotations_from_cmu,
+                                                rotations_from_makehuman_bvh, symmetry_error)
+from kinect_retarget.autorig.geodesic import dijkstra  # noqa: E402
+from kinect_retarget.autorig.graph import mesh_graph  # noqa: E402
+from kinect_retarget.autorig.inside import inside_mesh  # noqa: E402
+from kinect_retarget.autorig.levels import reeb_baseline  # noqa: E402
+from kinect_retarget.autorig.mesh import Mesh  # noqa: E402
+from kinect_retarget.core.skeletons import KINECT_V1  # noqa: E402
+from kinect_retarget.takes.bvh import read_bvh_skeleton  # noqa: E402
+
+TOLERANCE = 3.0  # % of body height
+
+
+def subdivide(mesh: Mesh) -> Mesh:
+    """Split every triangle into four (edge midpoints shared): a denser copy of the same surface."""
+    f = mesh.faces
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    uniq, inv = np.unique(e, axis=0, return_inverse=True)
+    mid = len(mesh.vertices) + inv.reshape(3, -1).T  # (T, 3) midpoints of edges 01, 12, 20
+    verts = np.concatenate([mesh.vertices, mesh.vertices[uniq].mean(axis=1)])
+    a, b, c = f.T
+    ab, bc, ca = mid.T
+    faces = np.concatenate([np.stack(x, 1) for x in ((a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca))])
+    return Mesh(verts, faces, mesh.name + "-x4")
+
+
+def row(label: str, err: np.ndarray, extra: str = "") -> str:
+    worst = KINECT_V1.joints[int(np.argmax(err))]
+    ok = "ok " if err.max() <= TOLERANCE else "MISS"
+    return (f"{label:28s} mean {err.mean():5.2f}  max {err.max():5.2f} ({worst}){extra}  "
+            f"within {TOLERANCE:.0f}%: {int((err <= TOLERANCE).sum())}/20 {ok}")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--frames", type=int, default=4, help="CMU frames per motion")
+    args = ap.parse_args()
+    mh = load_makehuman(DATA / "meshes" / "makehuman")
+    h = mh.height
+    print(f"MakeHuman base mesh, group 'body': {len(mh.body.vertices)} vertices, {len(mh.body.faces)} triangles, "
+          f"height {h:.2f} dm; errors in % of height (3 % = {0.03 * h * 10:.1f} cm)\n")
+
+    print("== joint accuracy against default.mhskel (Kinect v1 joints)")
+    rest = autorig(mh.body)
+    err = joint_errors(rest.joints, reference_joints(mh), h)
+    print(row("rest (A-pose)", err))
+    print("   per joint: " + ", ".join(f"{n} {e:.1f}" for n, e in zip(KINECT_V1.joints, err)))
+    all_err = [err]
+    poses = []
+    for name in ("tpose.bvh", "benchmark.bvh"):
+        poses.append((f"MakeHuman {name}", rotations_from_makehuman_bvh(
+            mh, read_bvh_skeleton(DATA / "meshes" / "makehuman" / name))))
+    for name in ("01_01", "131_01", "131_02", "131_03"):
+        motion = read_bvh_skeleton(DATA / "mocap_bvh" / f"{name}.bvh")
+        for fr in np.linspace(0, motion.frame_count - 1, args.frames + 1).astype(int)[1:]:
+            poses.append((f"CMU {name} frame {fr}", rotations_from_cmu(mh, motion, fr)))
+    failures = 0
+    inside_all = [inside_mesh(rest.joints, mh.body.vertices, mh.body.faces)]
+    for label, rot in poses:
+        posed = pose_body(mh, rot)
+        try:
+            rig = autorig(posed)
+        except ValueError as exc:
+            failures += 1
+            print(f"{label:28s} FAILED: {exc}")
+            continue
+        e = joint_errors(rig.joints, reference_joints(mh, rot), h)
+        all_err.append(e)
+        inside_all.append(inside_mesh(rig.joints, posed.vertices, posed.faces))
+        print(row(label, e))
+    stack = np.array(all_err)
+    print(f"\nover {len(stack)} meshes: mean {stack.mean():.2f} %, median joint max {np.median(stack.max(1)):.2f} %, "
+          f"worst {stack.max():.2f} %; joints within {TOLERANCE:.0f} %: {(stack <= TOLERANCE).mean():.1%}; "
+          f"rigging failures {failures}")
+    per_joint = stack.mean(axis=0)
+    print("mean error per joint over all meshes: " + ", ".join(f"{n} {e:.1f}" for n, e in zip(KINECT_V1.joints, per_joint)))
+    ins = np.array(inside_all)
+    print(f"joints inside the mesh (winding number > 0.5): {ins.mean():.1%} "
+          f"({int((~ins).sum())} outside over {len(ins)} meshes)")
+
+    print("\n== symmetry (rest mesh is symmetric about x = 0)")
+    print(f"largest left/right mismatch: {symmetry_error(rest.joints, np.array([1.0, 0, 0]), np.zeros(3), h):.3f} % "
+          f"of height (goal <= 1 %)")
+
+    print("\n== time, end to end (load excluded; graph, feature points, levels, joints, weights)")
+    meshes = [("body group", mh.body), ("whole base.obj (154 pieces)", mh.full),
+              ("body subdivided x4", subdivide(mh.body))]
+    for label, mesh in meshes:
+        best, tm = np.inf, {}
+        for _ in range(3):
+            t = time.perf_counter()
+            rig = autorig(mesh)
+            if time.perf_counter() - t < best:
+                best, tm = time.perf_counter() - t, rig.report["timings"]
+        print(f"{label:30s} {len(mesh.vertices):6d} vertices: {best:.2f} s  (graph {tm['graph']:.2f}, "
+              f"+features {tm['features'] - tm['graph']:.2f}, +joints {tm['joints'] - tm['features']:.2f}, "
+              f"+weights {tm['weights'] - tm['joints']:.2f})")
+    g = mesh_graph(mh.body.vertices, mh.body.faces)
+    t = time.perf_counter()
+    for s in range(10):
+        dijkstra(g, [s * 1000])
+    print(f"one Dijkstra on {g.n} vertices / {len(g.edges)} edges: {(time.perf_counter() - t) / 10 * 1000:.0f} ms")
+    t = time.perf_counter()
+    load_mesh(DATA / "meshes" / "makehuman" / "base.obj", group="body")
+    print(f"loading base.obj (group body): {time.perf_counter() - t:.2f} s")
+
+    print("\n== paper table 3: skeleton points per level (K = 4)")
+    print(f"{'mesh':24s} {'method':28s} level 0  1  2  3   total")
+    for label, mesh in (("rest", mh.body), ("benchmark.bvh", pose_body(mh, poses[1][1]))):
+        rig = autorig(mesh)
+        gph = mesh_graph(mesh.vertices[rig.body], rig_faces(mesh, rig))
+        reeb = reeb_baseline(mesh.vertices[rig.body], gph, rig.features.distances[0], 4)
+        for method, sk in (("paper (segments x levels)", rig.paper), ("Reeb graph of head geodesic", reeb)):
+            c = sk.count_per_level(4)
+            print(f"{label:24s} {method:28s}       {c[0]:2d} {c[1]:2d} {c[2]:2d} {c[3]:2d}   {c.sum():3d}")
+
+
+def rig_faces(mesh: Mesh, rig) -> np.ndarray:
+    remap = np.full(len(mesh.vertices), -1)
+    remap[rig.body] = np.arange(len(rig.body))
+    f = remap[mesh.faces]
+    return f[(f >= 0).all(axis=1)]
+
+
+if __name__ == "__main__":
+    main()
