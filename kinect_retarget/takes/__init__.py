@@ -11,7 +11,7 @@ from importlib import import_module
 from ..core.take import Take, TakeError
 
 # Tried in order: the most specific signatures first.
-READERS = ("krtake", "kinectron_json", "bvh", "kinect_v2_csv", "msrc12", "utkinect", "ntu_skeleton")
+READERS = ("krtake", "kinectron_json", "bvh", "kinect_v2_csv", "uiprmd", "msrc12", "utkinect", "ntu_skeleton")
 
 
 def detect_format(path: str | os.PathLike) -> str:
