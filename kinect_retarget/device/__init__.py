@@ -1,0 +1,25 @@
+"""Kinect v1 over USB in pure Python (pyusb + numpy): discovery, depth stream, motor, emulated device.
+
+The API the rest of the extension uses (no bpy anywhere in this package):
+
+    list_devices(backend=None) -> [KinectInfo]          what is plugged in, and why it can't be used if so
+    DepthStream(source).start() / .stop() / .frames      a bounded queue of DepthFrame, filled by a thread
+    DepthStream.status -> StreamStatus                    state text, message, fps, frames, dropped frames
+    set_tilt(angle) / open_motor().set_led(mode) / .state()
+    depth_preview(frame.mm) -> (120, 160) uint8           for a live preview image
+    EmulatedKinect(images, faults=Faults(...))           an emulated Kinect (pyusb backend) for tests/demo
+"""
+from .calibration import Calibration
+from .discovery import KinectInfo, find_kinect, list_devices
+from .emulated import EmulatedKinect
+from .emulated_stream import Faults, VirtualClock
+from .errors import (AccessDenied, DeviceGone, DeviceNotFound, DumpError, KinectError, LibusbMissing,
+                     MotorUnavailable, ProtocolError)
+from .motor import KinectMotor, MotorState, open_motor, set_tilt
+from .preview import depth_preview
+from .stream import DepthFrame, DepthStream, StreamStatus
+
+__all__ = ["Calibration", "KinectInfo", "find_kinect", "list_devices", "EmulatedKinect", "Faults",
+           "VirtualClock", "AccessDenied", "DeviceGone", "DeviceNotFound", "DumpError", "KinectError",
+           "LibusbMissing", "MotorUnavailable", "ProtocolError", "KinectMotor", "MotorState", "open_motor",
+           "set_tilt", "depth_preview", "DepthFrame", "DepthStream", "StreamStatus"]

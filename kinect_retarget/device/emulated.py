@@ -23,6 +23,7 @@ from usb.core import USBError
 
 from . import protocol as P
 from .protocol import TICKS_PER_FRAME
+from .depth_unpack import pack_11bit
 from .emulated_stream import DepthPacketizer, EmulatedIsoPump, Faults, VirtualClock
 
 LIBUSB_ERROR_PIPE = -9
@@ -98,12 +99,13 @@ class EmulatedKinect(usb.backend.IBackend):
     """
 
     def __init__(self, images, model: str = "1414", serial: str = DEFAULT_SERIAL, faults: Faults | None = None,
-                 clock=None, sleep=None, bus: int = 1):
+                 clock=None, sleep=None, bus: int = 1, audio_firmware: bool = False):
         super().__init__()
         self.images = [np.asarray(img, dtype=np.uint16) for img in images]
         if not self.images:
             raise ValueError("the emulated Kinect needs at least one depth image")
         self.model = model
+        self._packed = [pack_11bit(img) for img in self.images]   # once: the wire format of each image
         self.faults = faults or Faults()
         if isinstance(clock, VirtualClock) and sleep is None:
             sleep = clock.sleep
@@ -116,7 +118,8 @@ class EmulatedKinect(usb.backend.IBackend):
         self._stream_ids = itertools.count(1)
         self._first_start: float | None = None
         self._manual_plugged = True
-        self.functions = self._build_functions(model, serial)
+        self.functions = self._build_functions(model, serial, audio_firmware)
+        self._bulk_replies: list[bytes] = []
         self._assign_addresses()
         self._power_on()
         self.depth_starts = 0                   # how many times the depth stream was started
@@ -137,7 +140,7 @@ class EmulatedKinect(usb.backend.IBackend):
 
     # --- topology ----------------------------------------------------------------------------------------
     @staticmethod
-    def _build_functions(model: str, serial: str) -> list[_UsbFunction]:
+    def _build_functions(model: str, serial: str, audio_firmware: bool) -> list[_UsbFunction]:
         iso = P.MAX_ISO_PACKET_SIZE // 2 | (1 << 11)             # 960 bytes x 2 transactions per microframe
         camera_alt0 = _interface(0, 0, [_endpoint(P.VIDEO_ENDPOINT, iso), _endpoint(P.DEPTH_ENDPOINT, iso)])
         if model == "1414":
@@ -158,9 +161,14 @@ class EmulatedKinect(usb.backend.IBackend):
             camera = _UsbFunction("camera", P.PID_CAMERA_K4W, 0x0100, "Kinect for Windows Camera",
                                   "0000000000000000", [[alt0, alt1]], (1, 1))
             audio_pid = P.PID_AUDIO_K4W
-        # Audio chip in its bootloader: one interface; motor/LED need the proprietary audio firmware.
-        audio = _UsbFunction("audio", audio_pid, 0x0100, "Xbox Kinect Audio", serial,
-                             [[_interface(0, 0, [_endpoint(0x81, 512), _endpoint(0x01, 512)])]], (1, 3))
+        # Audio chip: in its bootloader it has one interface and no motor/LED; with the (proprietary) audio
+        # firmware running it has more, and takes motor commands on bulk endpoints 0x01/0x81.
+        interfaces = [[_interface(0, 0, [_endpoint(0x81, 512), _endpoint(0x01, 512)])]]
+        if audio_firmware:
+            interfaces.append([_interface(1, 0, [_endpoint(0x82, 512)], cls=0x01)])
+        audio = _UsbFunction("audio", audio_pid, 0x0100, "Xbox Kinect Audio", serial, interfaces, (1, 3))
+        for desc in interfaces[0][0].endpoints:
+            desc.bmAttributes = 0x02                                  # bulk
         return [camera, audio]
 
     def _assign_addresses(self) -> None:
@@ -376,7 +384,7 @@ class EmulatedKinect(usb.backend.IBackend):
                 self._first_start = now
             sid = next(self._stream_ids)
             seq0 = (sid * 97) & 0xFF                     # streams do not restart at sequence 0
-            packetizer = DepthPacketizer(self.images, seq0, sid * 12_345_678)
+            packetizer = DepthPacketizer(self.images, seq0, sid * 12_345_678, packed=self._packed)
             self.depth_stream = _DepthStreamState(sid, now, packetizer)
             self.streams.append(packetizer)
             self.depth_starts += 1
@@ -411,6 +419,39 @@ class EmulatedKinect(usb.backend.IBackend):
         moving = self.tilt_deg != self._tilt_target
         status = 4 if moving else (1 if abs(self.tilt_deg) >= 27.0 else 0)
         return struct.pack(">2xhhhbB", ax, ay, az, round(self.tilt_deg * 2), status)
+
+    # --- audio-chip motor commands (bulk) ---------------------------------------------------------------------
+    def bulk_write(self, dev_handle, ep, intf, data, timeout):
+        with self._lock:
+            self.check_handle(dev_handle)
+            fn = dev_handle.function
+            if fn.kind != "audio" or len(fn.interfaces) < 2 or ep != 0x01 or len(data) < 16:
+                self._stall()
+            magic, tag, arg1, cmd = struct.unpack_from("<4I", bytes(data))
+            arg2 = struct.unpack_from("<i", bytes(data), 16)[0] if len(data) >= 20 else 0
+            status = 0 if magic == 0x06022009 else 1
+            self._advance_motor()
+            if status == 0 and cmd == 0x803B:
+                self._tilt_target = max(-27.0, min(27.0, float(arg2)))
+            elif status == 0 and cmd == 0x10:
+                self.led = arg2
+            elif status == 0 and cmd == 0x8032:
+                theta = math.radians(self.tilt_deg)
+                body = bytearray(104)
+                struct.pack_into("<4i", body, 16, 0, round(COUNTS_PER_G * math.cos(theta)),
+                                 round(COUNTS_PER_G * math.sin(theta)), round(self.tilt_deg))
+                self._bulk_replies.append(bytes(body))
+            elif status == 0:
+                status = 2
+            self._bulk_replies.append(struct.pack("<3I", 0x0A6FE000, tag, status))
+            return len(data)
+
+    def bulk_read(self, dev_handle, ep, intf, buff, timeout):
+        with self._lock:
+            self.check_handle(dev_handle)
+            if ep != 0x81 or not self._bulk_replies:
+                raise USBError("Operation timed out", -7, errno.ETIMEDOUT)
+            return self._fill(buff, self._bulk_replies.pop(0))
 
     # --- the iso seam -------------------------------------------------------------------------------------
     def open_iso_pump(self, dev_handle, endpoint: int, transfers: int, packets_per_transfer: int):

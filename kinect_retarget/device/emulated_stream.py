@@ -38,8 +38,9 @@ class Faults:
 class DepthPacketizer:
     """Packets of one depth stream: frame f of the stream shows images[f % len(images)]."""
 
-    def __init__(self, images: list[np.ndarray], first_seq: int = 0, first_timestamp: int = 0):
-        self._packed = [pack_11bit(img) for img in images]
+    def __init__(self, images: list[np.ndarray], first_seq: int = 0, first_timestamp: int = 0,
+                 packed: list[bytes] | None = None):
+        self._packed = packed if packed is not None else [pack_11bit(img) for img in images]
         self.first_seq = first_seq
         self.first_timestamp = first_timestamp
 

@@ -19,6 +19,7 @@ from .protocol import (DEPTH_FRAME_BYTES, DEPTH_LAST_PAYLOAD, DEPTH_PACKETS_PER_
 
 MAX_GAP = 5
 MAX_LOST_PER_FRAME = 5
+MAX_COUNTED_GAP = 300        # a longer timestamp jump is a restarted stream, not lost frames
 _FILL = b"\xff" * DEPTH_FRAME_BYTES
 
 
@@ -39,6 +40,7 @@ class AssemblyStats:
     packets_damaged: int = 0   # truncated payloads
     frames: int = 0            # delivered
     frames_dropped: int = 0    # started but not delivered
+    frames_missed: int = 0     # gaps between delivered frames' timestamps: every frame not delivered
     resyncs: int = 0
     extra: dict = field(default_factory=dict)
 
@@ -54,6 +56,7 @@ class FrameAssembler:
         self._lost = 0
         self._holes: list = []
         self._timestamp = 0
+        self._last_delivered: int | None = None
         self._buf = bytearray()
 
     def reset(self) -> None:
@@ -108,6 +111,10 @@ class FrameAssembler:
             self.stats.frames_dropped += 1
             return None
         self.stats.frames += 1
+        if self._last_delivered is not None:
+            gap = round(((self._timestamp - self._last_delivered) & 0xFFFFFFFF) / TICKS_PER_FRAME) - 1
+            self.stats.frames_missed += gap if 0 < gap < MAX_COUNTED_GAP else 0
+        self._last_delivered = self._timestamp
         return AssembledFrame(buf, self._timestamp, lost, holes)
 
     def _skip(self, count: int, seq: int) -> None:

@@ -18,10 +18,10 @@ import usb.core
 
 from .calibration import Calibration
 from .camera import KinectCamera, is_gone
-from .depth_unpack import blank_byte_ranges, unpack_11bit
+from .decode import decode_frame
 from .discovery import KinectInfo, find_kinect
 from .errors import DeviceGone, DeviceNotFound, KinectError
-from .protocol import DEPTH_ENDPOINT, TICKS_PER_FRAME
+from .protocol import DEPTH_ENDPOINT
 from .reassembly import FrameAssembler
 from .usb_backend import DEFAULT_PACKETS_PER_TRANSFER, DEFAULT_TRANSFERS, open_iso_pump
 
@@ -186,8 +186,6 @@ class DepthStream:
 
     def _pump_loop(self, pump, calibration: Calibration, lut: np.ndarray) -> None:
         assembler = FrameAssembler()
-        prev_ts = None
-        dropped_gaps = 0
         base_dropped = self._status.frames_dropped
         base_lost = self._status.packets_lost
         while not self._stop.is_set():
@@ -197,20 +195,13 @@ class DepthStream:
             if self.packet_hook is not None:
                 self.packet_hook(packets)
             for done in assembler.feed(packets):
-                if prev_ts is not None:
-                    gap = round(((done.timestamp - prev_ts) & 0xFFFFFFFF) / TICKS_PER_FRAME) - 1
-                    dropped_gaps += gap if 0 < gap < 300 else 0
-                prev_ts = done.timestamp
                 self._deliver(done, calibration, lut)
             stats = assembler.stats
-            self._set(frames_dropped=base_dropped + dropped_gaps, packets_lost=base_lost + stats.packets_lost,
+            self._set(frames_dropped=base_dropped + stats.frames_missed, packets_lost=base_lost + stats.packets_lost,
                       thread_cpu_s=time.thread_time())
 
     def _deliver(self, done, calibration: Calibration, lut: np.ndarray) -> None:
-        raw = unpack_11bit(done.packed)
-        if done.holes:
-            blank_byte_ranges(raw, done.holes)
-        mm = lut[raw] if self.convert_mm else None
+        raw, mm = decode_frame(done, lut if self.convert_mm else None)
         now = time.monotonic()
         self._recent.append(now)
         fps = (len(self._recent) - 1) / (now - self._recent[0]) if len(self._recent) > 1 else 0.0

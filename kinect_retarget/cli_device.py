@@ -1,0 +1,229 @@
+"""Device commands: `devices`, `capture`, `tilt`, `led`, `accel` (plain Python; no Blender needed).
+
+`--simulate` runs any of them against the emulated Kinect instead of USB hardware.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import queue
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .device.calibration import Calibration
+from .device.decode import decode_frame
+from .device.errors import KinectError
+
+SIMULATE_HELP = "use the emulated Kinect instead of USB hardware"
+
+
+def add_parsers(sub) -> None:
+    p = sub.add_parser("devices", help="list connected Kinects and what keeps them from working")
+    p.add_argument("--udev-rule", action="store_true", help="print the Linux udev rule (and how to install it)")
+    p.add_argument("--json", action="store_true", help="one JSON object per Kinect")
+    _add_simulate(p)
+    p.set_defaults(handler=run_devices)
+
+    p = sub.add_parser("capture", help="record depth frames to an .npz (raw, mm, timestamp, calibration)")
+    src = p.add_mutually_exclusive_group()
+    src.add_argument("--simulate", action="store_true", help=SIMULATE_HELP)
+    src.add_argument("--replay", metavar="DUMP", help="decode a packet dump offline instead of streaming")
+    p.add_argument("--simulate-from", metavar="DIR", help="fakenect recording (d-*.pgm) for --simulate")
+    p.add_argument("--seconds", type=float, default=5.0, help="how long to record (default 5)")
+    p.add_argument("--out", required=True, metavar="DEPTH.npz")
+    p.add_argument("--dump", metavar="DUMP", help="also write every isochronous packet as received")
+    p.add_argument("--serial", help="which Kinect, when several are plugged in")
+    p.set_defaults(handler=run_capture)
+
+    p = sub.add_parser("tilt", help="tilt the Kinect (degrees from the horizon, -27..27)")
+    p.add_argument("--angle", type=float, required=True)
+    _add_simulate(p)
+    p.set_defaults(handler=run_tilt)
+
+    p = sub.add_parser("led", help="set the Kinect's LED")
+    p.add_argument("mode", choices=["green", "red", "yellow", "blink", "off"])
+    _add_simulate(p)
+    p.set_defaults(handler=run_led)
+
+    p = sub.add_parser("accel", help="print the accelerometer (gravity, in g) and the tilt angle")
+    _add_simulate(p)
+    p.set_defaults(handler=run_accel)
+
+
+def _add_simulate(p) -> None:
+    p.add_argument("--simulate", action="store_true", help=SIMULATE_HELP)
+    p.add_argument("--serial", help="which Kinect, when several are plugged in")
+
+
+def _backend(args):
+    """The emulated Kinect for --simulate, else None (pyusb's libusb1 backend)."""
+    if not getattr(args, "simulate", False):
+        return None
+    from .device.depth_images import load_fakenect_dir, synthetic_depth_frames
+    from .device.emulated import EmulatedKinect
+    folder = getattr(args, "simulate_from", None)
+    return EmulatedKinect(load_fakenect_dir(folder) if folder else synthetic_depth_frames())
+
+
+def _fail(exc: Exception) -> int:
+    print(f"error: {exc}", file=sys.stderr)
+    return 1
+
+
+# --- devices ---------------------------------------------------------------------------------------------------
+def run_devices(args) -> int:
+    from .device.discovery import UDEV_RULES, UDEV_RULES_PATH, list_devices, udev_rule_install_command
+    if args.udev_rule:
+        print(f"# {UDEV_RULES_PATH}\n{UDEV_RULES}\n# install it with:\n{udev_rule_install_command()}")
+        return 0
+    try:
+        kinects = list_devices(_backend(args))
+    except KinectError as exc:
+        return _fail(exc)
+    if args.json:
+        for k in kinects:
+            print(json.dumps({"model": k.model, "serial": k.serial, "bus": k.bus, "address": k.address,
+                              "camera_available": k.camera_available, "motor_available": k.motor_available,
+                              "motor_note": k.motor_note, "problem": k.problem}))
+    elif not kinects:
+        print("no Kinect found (is it plugged in and powered by its own adapter?)")
+    else:
+        print("\n".join(k.describe() for k in kinects))
+    return 0
+
+
+# --- capture ---------------------------------------------------------------------------------------------------
+def _save(path: str, raws, mms, stamps, lost, calibration: Calibration) -> None:
+    shape = (0, 480, 640)
+    out = Path(path)
+    with open(out, "wb") as f:     # an open file keeps numpy from appending ".npz" to other suffixes
+        np.savez(f, raw=np.array(raws, dtype=np.uint16).reshape(-1, 480, 640) if raws else np.zeros(shape, np.uint16),
+                 mm=np.array(mms, dtype=np.uint16).reshape(-1, 480, 640) if mms else np.zeros(shape, np.uint16),
+                 timestamp=np.array(stamps, dtype=np.int64), lost_packets=np.array(lost, dtype=np.int32),
+                 calibration=json.dumps(calibration.as_dict()),
+                 **{f"calibration_{k}": v for k, v in calibration.as_dict().items() if k != "source"})
+
+
+def _capture_replay(args) -> int:
+    from .device.dump import replay_dump
+    frames, assembler, error = replay_dump(args.replay)
+    calibration = Calibration()          # a dump holds packets only: typical calibration values are used
+    lut = calibration.raw_to_mm_table()
+    raws, mms = zip(*(decode_frame(f, lut) for f in frames)) if frames else ((), ())
+    _save(args.out, list(raws), list(mms), [f.timestamp for f in frames], [f.lost_packets for f in frames],
+          calibration)
+    s = assembler.stats
+    print(f"{len(frames)} frames decoded from {args.replay} ({s.packets_lost} packets lost, "
+          f"{s.frames_missed} frames dropped) -> {args.out}")
+    if error is not None:
+        print(f"warning: {error}; the frames before it were kept", file=sys.stderr)
+        return 1
+    return 0
+
+
+def run_capture(args) -> int:
+    if args.seconds <= 0 and not args.replay:
+        return _fail(ValueError("--seconds must be positive"))
+    try:
+        if args.replay:
+            return _capture_replay(args)
+        return _capture_live(args)
+    except KinectError as exc:
+        return _fail(exc)
+
+
+def _capture_live(args) -> int:
+    from .device.dump import DumpWriter
+    from .device.stream import STREAMING, DepthStream
+    backend = _backend(args)
+    dump = DumpWriter(args.dump) if args.dump else None
+    stream = DepthStream(backend, serial=args.serial, queue_size=64,
+                         packet_hook=dump.write_packets if dump else None)
+    raws, mms, stamps, lost = [], [], [], []
+    calibration = Calibration()
+    last_message, started = "", None
+    stream.start()
+    try:
+        while started is None or time.monotonic() - started < args.seconds:
+            status = stream.status
+            if status.message != last_message:
+                print(f"[{status.state}] {status.message}", file=sys.stderr)
+                last_message = status.message
+            if started is None and status.state == STREAMING:
+                started = time.monotonic()
+            if started is None and status.state == "error":
+                break
+            try:
+                frame = stream.frames.get(timeout=0.05)
+            except queue.Empty:
+                continue
+            raws.append(frame.raw)
+            mms.append(frame.mm)
+            stamps.append(frame.timestamp)
+            lost.append(frame.lost_packets)
+            calibration = frame.calibration
+    except KeyboardInterrupt:
+        print("interrupted: saving what was captured", file=sys.stderr)
+    finally:
+        stream.stop()
+        if dump:
+            dump.close()
+    status = stream.status
+    _save(args.out, raws, mms, stamps, lost, calibration)
+    print(f"{len(raws)} frames -> {args.out} (dropped {status.frames_dropped}, "
+          f"packets lost {status.packets_lost})" + (f"; packets -> {args.dump}" if dump else ""))
+    return 0 if raws else 1
+
+
+# --- motor ---------------------------------------------------------------------------------------------------
+def _motor(args):
+    from .device.motor import open_motor
+    return open_motor(_backend(args), args.serial)
+
+
+def run_tilt(args) -> int:
+    try:
+        motor = _motor(args)
+        sent = motor.set_tilt(args.angle)
+    except KinectError as exc:
+        return _fail(exc)
+    print(f"tilting to {sent:g} degrees" + (" (clamped to the ±27 degree range)" if sent != args.angle else ""))
+    return 0
+
+
+def run_led(args) -> int:
+    try:
+        _motor(args).set_led(args.mode)
+    except KinectError as exc:
+        return _fail(exc)
+    print(f"LED {args.mode}")
+    return 0
+
+
+def run_accel(args) -> int:
+    try:
+        state = _motor(args).state()
+    except KinectError as exc:
+        return _fail(exc)
+    x, y, z = state.accel_g
+    tilt = "unknown" if state.tilt_deg is None else f"{state.tilt_deg:g} degrees"
+    print(f"accelerometer (g): x {x:+.3f}  y {y:+.3f}  z {z:+.3f}\ntilt: {tilt} ({state.status})")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m kinect_retarget.cli_device")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    add_parsers(sub)
+    args = parser.parse_args(argv)
+    try:
+        return int(args.handler(args) or 0)
+    except (ValueError, OSError) as exc:
+        return _fail(exc)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
