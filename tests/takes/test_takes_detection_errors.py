@@ -164,4 +164,4 @@ def test_corrupted_kinectron(shared_data, tmp_path):
 
 def test_readers_registered():
     assert {"krtake", "bvh", "kinect_v2_csv", "kinectron_json", "ntu_skeleton", "msrc12",
-            "utkinect"} <= set(READERS)
+            "utkinect", "uiprmd"} <= set(READERS)
