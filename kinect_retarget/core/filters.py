@@ -107,22 +107,41 @@ class OneEuroFilter:
             return x.copy()
         dt = 1.0 / self.rate if t is None or self._t is None or t <= self._t else t - self._t
         self._t = t
+        self._advance(x, valid, dt, bool(valid.all() and self._seen.all()))
+        return self._x.copy()
+
+    def _advance(self, x: np.ndarray, valid: np.ndarray, dt: float, all_valid: bool) -> None:
         dx = (x - self._x) / dt
         dx_hat = self._dx + self._alpha(self.d_cutoff, dt) * (dx - self._dx)
         cutoff = self.min_cutoff + self.beta * np.abs(dx_hat)
-        a = 1.0 / (1.0 + 1.0 / (2 * math.pi * cutoff * dt))
+        a = 1.0 / (1.0 + 1.0 / (2 * math.pi * dt * cutoff))
         x_hat = self._x + a * (x - self._x)
+        if all_valid:  # the common case skips the bookkeeping below; same numbers
+            self._x, self._dx = x_hat, dx_hat
+            return
         restart = valid & ~self._seen  # a joint coming back starts from its raw position
         x_hat = np.where(restart, x, x_hat)
         self._x = np.where(valid, x_hat, self._x)
         self._dx = np.where(valid & ~restart, dx_hat, 0.0)
         self._seen = valid
-        return self._x.copy()
 
     def run(self, positions: np.ndarray, states: np.ndarray, times: np.ndarray | None = None) -> np.ndarray:
-        out = np.empty_like(np.asarray(positions, dtype=np.float64))
-        for i in range(out.shape[0]):
-            out[i] = self.step(positions[i], states[i], None if times is None else float(times[i]))
+        positions = np.asarray(positions, dtype=np.float64)
+        out = np.empty_like(positions)
+        if out.shape[0] == 0:
+            return out
+        valid = np.asarray(states) != NOT_TRACKED
+        all_valid = valid.all(axis=1)
+        start = 0
+        if self._x is None:
+            out[0] = self.step(positions[0], states[0], None if times is None else float(times[0]))
+            start = 1
+        for i in range(start, out.shape[0]):
+            t = None if times is None else float(times[i])
+            dt = 1.0 / self.rate if t is None or self._t is None or t <= self._t else t - self._t
+            self._t = t
+            self._advance(positions[i], valid[i][:, None], dt, bool(all_valid[i] and self._seen.all()))
+            out[i] = self._x
         return out
 
 

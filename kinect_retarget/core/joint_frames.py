@@ -127,14 +127,20 @@ def hinge_axis(get: GetJoint, side: str, kind: str, y_upper: np.ndarray, world_l
 
 
 def limb_hint(get: GetJoint, side: str, kind: str, level: int, y: np.ndarray, world_lateral: np.ndarray,
-              world_up: np.ndarray) -> np.ndarray:
+              world_up: np.ndarray, cache: dict | None = None) -> np.ndarray:
     """X hint for the upper (level 0), lower (1) or end (2: hand, foot) segment of a limb. Lower segments
     carry the upper segment's hinge across by the minimal rotation between the segments, so nothing
     twists at the elbow, knee, wrist or ankle."""
     names = (("Shoulder", "Elbow", "Wrist", "Hand") if kind == "arm" else ("Hip", "Knee", "Ankle", "Foot"))
     dirs = [_sub(get(names[i + 1] + side), get(names[i] + side)) for i in range(3)]
     y_upper = y if level == 0 or dirs[0] is None else dirs[0]
-    hint = hinge_axis(get, side, kind, y_upper, world_lateral, world_up)
+    key = (side, kind)
+    if cache is not None and key in cache:  # per-solve cache: the source's y_upper is always dirs[0]
+        hint = cache[key]
+    else:
+        hint = hinge_axis(get, side, kind, y_upper, world_lateral, world_up)
+        if cache is not None and dirs[0] is not None:
+            cache[key] = hint
     for i in range(1, level + 1):
         prev = y_upper if i == 1 else dirs[i - 1]
         cur = y if i == level or dirs[i] is None else dirs[i]
@@ -145,7 +151,7 @@ def limb_hint(get: GetJoint, side: str, kind: str, level: int, y: np.ndarray, wo
 
 
 def segment_hint(get: GetJoint, tail: str, y: np.ndarray, world_lateral: np.ndarray,
-                 world_up: np.ndarray) -> np.ndarray:
+                 world_up: np.ndarray, cache: dict | None = None) -> np.ndarray:
     """The X-direction hint for the segment ending at joint `tail` whose direction is `y`."""
     role, side = role_and_side(tail)
     if role in ("pelvis", "spine"):
@@ -155,4 +161,4 @@ def segment_hint(get: GetJoint, tail: str, y: np.ndarray, world_lateral: np.ndar
     if role in ("clavicle", "hip"):
         return np.cross(y, up_vector(get, world_up))
     kind, level = LIMB_LEVELS[role]
-    return limb_hint(get, side, kind, level, y, world_lateral, world_up)
+    return limb_hint(get, side, kind, level, y, world_lateral, world_up, cache)

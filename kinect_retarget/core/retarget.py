@@ -21,7 +21,7 @@ from .conventions import KINECT_TO_BLENDER
 from .joint_frames import ALIASES, frame_from_y_hint, resolver, segment_hint
 from .quat import from_matrix
 from .skeletons import Skeleton
-from .target_rig import TargetRig, _topological
+from .target_rig import TargetRig
 
 ROOT_MODES = ("xyz", "xy", "none")
 
@@ -127,24 +127,35 @@ class Retargeter:
             hint = segment_hint(get_t, m.tail_name, y, self.world_lateral, self.world_up)
             o_t = frame_from_y_hint(y, np.nan_to_num(hint))
             self.constants[k] = o_t.T @ rig.rest[m.index, :3, :3]
-        self._plan = self._chain_plan()
+        self._chain_plan()
         self.root_scale = root_scale
 
-    def _chain_plan(self) -> list[tuple[int, int, np.ndarray, int | None, bool]]:
-        """Bones to evaluate in order: (bone, parent, R_rel, mapped slot or None, inherit_rotation)."""
+    def _chain_plan(self) -> None:
+        """For each mapped bone: the nearest mapped ancestor (or -1) and the fixed rotation S between that
+        ancestor's posed frame and this bone's parent frame (rest-relative rotations of unmapped bones in
+        between; the bone's own rest-relative rotation included). Then frame_rot(b) = D[ancestor] · S."""
         rig = self.rig
         slot = {m.index: k for k, m in enumerate(self.mapped)}
-        needed = set(slot)
-        for b in list(slot):
-            needed.update(rig.ancestors(b))
-        plan = []
-        for b in _topological(rig):
-            if b not in needed:
+        self.anchor = np.full(len(self.mapped), -1)
+        self.static = np.empty((len(self.mapped), 3, 3))
+        for k, m in enumerate(self.mapped):
+            b = m.index
+            if not rig.inherit_rotation[b]:  # rotation ignores the parent: rest orientation only
+                self.static[k] = rig.rest[b, :3, :3]
                 continue
-            p = int(rig.parents[b])
-            rel = rig.rest[b, :3, :3] if p < 0 else rig.rest[p, :3, :3].T @ rig.rest[b, :3, :3]
-            plan.append((b, p, rel, slot.get(b), bool(rig.inherit_rotation[b])))
-        return plan
+            chain = np.eye(3)
+            child, p = b, int(rig.parents[b])
+            while p >= 0 and p not in slot:
+                chain = rig.rest[p, :3, :3].T @ rig.rest[child, :3, :3] @ chain
+                if not rig.inherit_rotation[p]:
+                    break
+                child, p = p, int(rig.parents[p])
+            if p >= 0 and p in slot:
+                self.anchor[k] = slot[p]
+                self.static[k] = rig.rest[p, :3, :3].T @ rig.rest[child, :3, :3] @ chain
+            else:  # reached the top: armature space
+                self.static[k] = rig.rest[child, :3, :3] @ chain
+        self.has_anchor = self.anchor >= 0
 
     def scale_for(self, source_leg: float | None) -> float:
         """Root scale n (eq. 13): target leg / source leg, unless fixed."""
@@ -163,21 +174,15 @@ class Retargeter:
         p = np.asarray(positions, dtype=np.float64) @ self.arm_from_kinect.T
         nframes = p.shape[0]
         get = resolver(self.skeleton.joints, p)
-        desired = np.empty((nframes, len(self.mapped), 3, 3))
-        for k, m in enumerate(self.mapped):
-            y = p[:, m.tail] - p[:, m.head]
-            o_s = frame_from_y_hint(y, segment_hint(get, m.tail_name, y, self.world_lateral, self.world_up))
-            desired[:, k] = o_s @ self.constants[k]
-        posed: dict[int, np.ndarray] = {}
-        basis = np.empty_like(desired)
-        for b, parent, rel, k, inherit in self._plan:
-            parent_rot = posed[parent] @ rel if parent >= 0 else rel
-            if k is None:
-                posed[b] = parent_rot
-                continue
-            posed[b] = desired[:, k]
-            frame_rot = parent_rot if inherit else self.rig.rest[b, :3, :3]
-            basis[:, k] = np.swapaxes(frame_rot, -1, -2) @ desired[:, k]
+        cache: dict = {}
+        y = np.stack([p[:, m.tail] - p[:, m.head] for m in self.mapped], axis=1)
+        hints = np.stack([segment_hint(get, m.tail_name, y[:, k], self.world_lateral, self.world_up, cache)
+                          for k, m in enumerate(self.mapped)], axis=1)
+        desired = frame_from_y_hint(y, hints) @ self.constants          # (F, M, 3, 3), eq. 11
+        frame_rot = np.broadcast_to(self.static, desired.shape).copy()
+        if self.has_anchor.any():
+            frame_rot[:, self.has_anchor] = desired[:, self.anchor[self.has_anchor]] @ self.static[self.has_anchor]
+        basis = np.swapaxes(frame_rot, -1, -2) @ desired                  # eq. 12
         quats = from_matrix(basis)
         location = np.zeros((nframes, 3))
         if self.root is not None and self.root_mode != "none" and nframes:
@@ -185,18 +190,9 @@ class Retargeter:
             delta = (p[:, self.root.head] - ref) * self.scale_for(source_leg)
             if self.root_mode == "xy":
                 delta -= np.outer(delta @ self.world_up, self.world_up)
-            b = self.root.index
-            parent = int(self.rig.parents[b])
-            rel = self._plan_rel(b)
-            frame_rot = posed[parent] @ rel if parent >= 0 else rel
-            location = np.einsum("...ji,...j->...i", np.broadcast_to(frame_rot, (nframes, 3, 3)), delta)
+            k = self.mapped.index(self.root)
+            location = np.einsum("...ji,...j->...i", frame_rot[:, k], delta)
         return (quats, location, desired) if want_desired else (quats, location)
-
-    def _plan_rel(self, b: int) -> np.ndarray:
-        for bone, _, rel, _, _ in self._plan:
-            if bone == b:
-                return rel
-        raise KeyError(b)
 
 
 def _drop_unknown(get):
