@@ -8,6 +8,7 @@ errors reach `report()`. Live pushes no undo steps and holds object names, never
 from __future__ import annotations
 
 import os
+import sys
 import time
 from dataclasses import replace
 
@@ -62,7 +63,7 @@ class LiveController:
         if level == "ERROR":
             _last_status["error"] = message
         self.message = message
-        print(f"kinect_retarget: {message}")
+        print(f"kinect_retarget: {message}", file=sys.stderr)
 
     def _rigify_fk(self, obj) -> None:
         # the preset drives Rigify's FK controls: switch the limbs to FK while live (restored on stop)
@@ -85,14 +86,15 @@ class LiveController:
         return alive
 
     # -- recording ---------------------------------------------------------------------------------------------
-    def start_recording(self, context) -> str:
+    def start_recording(self, context, path: str | None = None) -> str:
         scene = self.scene()
         s = scene.kinect_retarget
-        folder = bpy.path.abspath(s.record_dir or "//kinect_takes/")
-        if folder.startswith("//") or not os.path.isabs(folder):  # unsaved file: // has no meaning
-            folder = os.path.join(bpy.app.tempdir or os.path.expanduser("~"), "kinect_takes")
         stamp = time.strftime("%Y%m%d_%H%M%S")
-        path = os.path.join(folder, f"{bpy.path.clean_name(self.obj_name)}_{stamp}.krtake")
+        if path is None:
+            folder = bpy.path.abspath(s.record_dir or "//kinect_takes/")
+            if folder.startswith("//") or not os.path.isabs(folder):  # unsaved file: // has no meaning
+                folder = os.path.join(bpy.app.tempdir or os.path.expanduser("~"), "kinect_takes")
+            path = os.path.join(folder, f"{bpy.path.clean_name(self.obj_name)}_{stamp}.krtake")
         name = f"{self.obj_name}_live_{stamp}"
         try:
             self.session.start_recording(path, {"name": name, "armature": self.obj_name,

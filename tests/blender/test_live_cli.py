@@ -1,0 +1,92 @@
+"""`python -m kinect_retarget live`: the headless pump loop, its JSON line, recording and bake into a .blend."""
+from __future__ import annotations
+
+import json
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+
+from kinect_retarget.sources.osc_codec import encode_message
+from kinect_retarget.takes import krtake
+
+REPO = Path(__file__).resolve().parents[2]
+SAMPLE = REPO / "sample_takes" / "kinect_v2_ges01_wavehand.krtake"
+
+
+def run_cli(*args, timeout=120):
+    proc = subprocess.run([sys.executable, "-m", "kinect_retarget", "live", *args], cwd=REPO,
+                          capture_output=True, text=True, timeout=timeout)
+    return proc
+
+
+def test_live_take_records_bakes_and_prints_one_json_line(tmp_path):
+    rec, out = tmp_path / "rec.krtake", tmp_path / "out.blend"
+    proc = run_cli("--source", f"take:{SAMPLE}", "--speed", "4", "--seconds", "5", "--record", str(rec),
+                   "--out", str(out))
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    lines = proc.stdout.strip().splitlines()
+    assert len(lines) == 1, proc.stdout
+    stats = json.loads(lines[0])
+    take = krtake.read(SAMPLE)
+    assert stats["received"] == take.frame_count == stats["recorded"]
+    assert stats["applied"] + stats["dropped"] + stats["untracked"] == stats["received"]
+    assert stats["latency_p50_ms"] is not None and stats["latency_p99_ms"] >= stats["latency_p50_ms"]
+    assert krtake.read(rec).frame_count == take.frame_count
+    assert out.is_file() and stats["action"].startswith("KinectRig_live_")
+
+
+def test_live_bad_source_is_a_clear_error(tmp_path):
+    proc = run_cli("--source", f"take:{tmp_path / 'missing.krtake'}", "--seconds", "1")
+    assert proc.returncode == 2 and "does not exist" in proc.stderr and "Traceback" not in proc.stderr
+    proc = run_cli("--source", "webcam", "--seconds", "1")
+    assert proc.returncode == 2 and "unknown source" in proc.stderr
+
+
+def _free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_live_osc_receives_ni_mate_frames_and_stops_on_garbage(tmp_path):
+    port = _free_port()
+    take = krtake.read(SAMPLE)
+    names = {"Head": "Head", "Neck": "Neck", "Torso": "SpineMid", "Left_Shoulder": "ShoulderLeft",
+             "Left_Elbow": "ElbowLeft", "Left_Hand": "HandLeft", "Right_Shoulder": "ShoulderRight",
+             "Right_Elbow": "ElbowRight", "Right_Hand": "HandRight", "Left_Hip": "HipLeft",
+             "Left_Knee": "KneeLeft", "Left_Foot": "FootLeft", "Right_Hip": "HipRight",
+             "Right_Knee": "KneeRight", "Right_Foot": "FootRight"}
+    idx = {n: take.skeleton.index(j) for n, j in names.items()}
+    stop = threading.Event()
+
+    def sender():
+        time.sleep(2.0)  # Blender start-up
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+            for i in range(40):
+                if stop.is_set():
+                    return
+                for n, j in idx.items():
+                    s.sendto(encode_message("/" + n, *map(float, take.positions[i, j])), ("127.0.0.1", port))
+                s.sendto(encode_message("/NI_mate_sync", "x"), ("127.0.0.1", port))
+                time.sleep(1 / 30)
+            s.sendto(b"garbage!", ("127.0.0.1", port))
+
+    t = threading.Thread(target=sender)
+    t.start()
+    try:
+        rec = tmp_path / "osc.krtake"
+        proc = run_cli("--source", f"osc:{port}", "--seconds", "20", "--record", str(rec))
+    finally:
+        stop.set()
+        t.join()
+    stats = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert proc.returncode == 1 and "bad OSC packet" in stats["error"]
+    assert stats["received"] == 40 and stats["applied"] > 0
+    kept = krtake.read(rec)
+    assert kept.frame_count == 40  # everything received before the garbage is kept
+    np.testing.assert_allclose(kept.positions[0, idx["Left_Hand"]], take.positions[0, idx["Left_Hand"]], atol=1e-5)
