@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from typing import IO
 
 import numpy as np
@@ -112,10 +113,11 @@ def read(path: str | os.PathLike) -> Take:
 
 def _parse_rows(path: str, lines: list[str], ncol: int, first_line: int) -> np.ndarray:
     """Parse whitespace-separated numeric rows fast, and name the first bad line when it fails."""
-    try:
-        flat = np.array(" ".join(lines).split(), dtype=np.float64)
-    except ValueError:
-        flat = None
+    # np.fromstring in text mode is the fastest numpy parser; it stops early on a bad token, which the
+    # size check below catches (then the slow path names the line)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)  # "could not be read to its end": bad token
+        flat = np.fromstring("\n".join(lines), sep=" ") if lines else np.empty(0)
     if flat is not None and flat.size == ncol * len(lines):
         values = flat.reshape(len(lines), ncol)
         if np.all(np.isfinite(values)):
