@@ -1,0 +1,210 @@
+"""Auto-Rig Mesh: the active mesh gets a Kinect-named armature in its own pose, vertex groups and an
+Armature modifier (paper 003 via kinect_retarget.autorig). One undo step; nothing changes on failure."""
+from __future__ import annotations
+
+import json
+
+import bpy
+import numpy as np
+from bpy.props import EnumProperty, IntProperty, StringProperty
+
+from ..autorig import AutoRig, Mesh, MeshError, autorig
+from ..autorig.weights import bone_segments
+
+AUTORIG_TAG = "kinect_retarget_autorig"
+WEIGHT_ITEMS = [("PROJECTION", "Bone Projection", "The paper's bone-projection weights (fast, pure numpy)"),
+                ("HEAT", "Heat (Blender)", "Blender's automatic weights (bone heat); slower, smoother")]
+
+
+def mesh_world_arrays(obj: bpy.types.Object) -> tuple[np.ndarray, np.ndarray]:
+    """(V, 3) vertex positions in world space and (T, 3) triangles of the object's own mesh data."""
+    me = obj.data
+    me.calc_loop_triangles()
+    co = np.empty(len(me.vertices) * 3, dtype=np.float64)
+    me.vertices.foreach_get("co", co)
+    tris = np.empty(len(me.loop_triangles) * 3, dtype=np.int64)
+    me.loop_triangles.foreach_get("vertices", tris)
+    m = np.array(obj.matrix_world, dtype=np.float64)
+    return co.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3], tris.reshape(-1, 3)
+
+
+def new_mesh_object(name: str, vertices: np.ndarray, faces: np.ndarray, collection) -> bpy.types.Object:
+    """A mesh object from (V, 3) positions and (T, 3) triangles (bulk foreach_set, no per-vertex Python)."""
+    me = bpy.data.meshes.new(name)
+    me.vertices.add(len(vertices))
+    me.vertices.foreach_set("co", np.asarray(vertices, dtype=np.float32).ravel())
+    me.loops.add(faces.size)
+    me.loops.foreach_set("vertex_index", np.asarray(faces, dtype=np.int32).ravel())
+    me.polygons.add(len(faces))
+    me.polygons.foreach_set("loop_start", np.arange(0, faces.size, 3, dtype=np.int32))
+    me.polygons.foreach_set("loop_total", np.full(len(faces), 3, dtype=np.int32))
+    me.update()
+    me.validate()
+    obj = bpy.data.objects.new(name, me)
+    collection.objects.link(obj)
+    return obj
+
+
+def build_armature(context, rig: AutoRig, name: str, collection) -> bpy.types.Object:
+    """Armature at the world origin whose rest pose is the extracted skeleton: bone j runs from joint j's
+    parent to joint j and is named after joint j; the root bone (the hip centre) is a stub up the trunk.
+    Rolls put each bone's Z axis toward the character's front, so both sides bend alike."""
+    arm = bpy.data.armatures.new(name)
+    obj = bpy.data.objects.new(name, arm)
+    collection.objects.link(obj)
+    obj["kinect_retarget_skeleton"] = rig.skeleton.name
+    heads, tails = bone_segments(rig.joints)
+    up, front = np.asarray(rig.features.up), np.asarray(rig.features.front)
+    view_layer = context.view_layer
+    previous = view_layer.objects.active
+    view_layer.objects.active = obj
+    bpy.ops.object.mode_set(mode="EDIT")
+    try:
+        edit = []
+        for j, joint in enumerate(rig.skeleton.joints):
+            eb = arm.edit_bones.new(joint)
+            eb.head, eb.tail = heads[j].tolist(), tails[j].tolist()
+            axis = tails[j] - heads[j]
+            axis /= max(np.linalg.norm(axis), 1e-12)
+            eb.align_roll((front if abs(axis @ front) < 0.9 else up).tolist())
+            edit.append(eb)
+        for j, p in enumerate(rig.skeleton.parents):
+            if p >= 0:
+                edit[j].parent = edit[p]
+    finally:
+        bpy.ops.object.mode_set(mode="OBJECT")
+        view_layer.objects.active = previous
+    return obj
+
+
+def assign_weights(mesh_obj: bpy.types.Object, rig: AutoRig) -> None:
+    """One vertex group per bone from the (V, 4) influences (existing groups of those names are replaced)."""
+    groups = mesh_obj.vertex_groups
+    for name in rig.bone_names:
+        if name in groups:
+            groups.remove(groups[name])
+    for b, name in enumerate(rig.bone_names):
+        group = groups.new(name=name)
+        rows, slots = np.nonzero((rig.weight_index == b) & (rig.weight > 0))
+        w = rig.weight[rows, slots]
+        # vertex_group.add takes one weight per call: batch the vertices that share a (rounded) weight
+        key = np.round(w, 4)
+        order = np.argsort(key, kind="stable")
+        values, starts = np.unique(key[order], return_index=True)
+        for value, chunk in zip(values, np.split(rows[order], starts[1:])):
+            group.add(chunk.tolist(), float(value), "REPLACE")
+
+
+def _heat_weights(context, mesh_obj, arm_obj, rig: AutoRig) -> str:
+    """Blender's bone-heat weights, limited to 4 influences and normalized; vertices heat leaves empty
+    (a known failure on meshes with intersecting pieces) keep the projection weights. Returns a note."""
+    view_layer = context.view_layer
+    for o in view_layer.objects:
+        o.select_set(False)
+    mesh_obj.select_set(True)
+    arm_obj.select_set(True)
+    view_layer.objects.active = arm_obj
+    bpy.ops.object.parent_set(type="ARMATURE_AUTO")
+    view_layer.objects.active = mesh_obj
+    bpy.ops.object.vertex_group_limit_total(limit=4)
+    bpy.ops.object.vertex_group_normalize_all(lock_active=False)
+    names = set(rig.bone_names)
+    total = np.zeros(len(mesh_obj.data.vertices))
+    for v in mesh_obj.data.vertices:
+        total[v.index] = sum(g.weight for g in v.groups if mesh_obj.vertex_groups[g.group].name in names)
+    empty = np.flatnonzero(total < 1e-6)
+    if len(empty):
+        for k, b in enumerate(rig.weight_index[empty].T):
+            for v, bone, w in zip(empty.tolist(), b.tolist(), rig.weight[empty, k].tolist()):
+                if w > 0:
+                    mesh_obj.vertex_groups[rig.bone_names[bone]].add([v], w, "REPLACE")
+        return f"; heat left {len(empty)} vertices unweighted, they use bone projection"
+    return ""
+
+
+def rig_mesh_object(context, mesh_obj: bpy.types.Object, weights: str = "PROJECTION", levels: int = 4,
+                    name: str | None = None) -> tuple[bpy.types.Object, AutoRig, str]:
+    """Rig `mesh_obj` in place. Raises MeshError (scene untouched) when no human skeleton can be built."""
+    if mesh_obj is None or mesh_obj.type != "MESH":
+        raise MeshError("select a mesh object to auto-rig")
+    if any(m.type == "ARMATURE" for m in mesh_obj.modifiers):
+        raise MeshError(f"{mesh_obj.name!r} already has an Armature modifier: remove it to rig the mesh again")
+    verts, tris = mesh_world_arrays(mesh_obj)
+    if len(tris) == 0:
+        raise MeshError(f"{mesh_obj.name!r} has no faces: not a surface mesh")
+    rig = autorig(Mesh(verts, tris, mesh_obj.name), levels=levels)  # may raise: nothing changed yet
+    collection = mesh_obj.users_collection[0] if mesh_obj.users_collection else context.scene.collection
+    arm_obj = build_armature(context, rig, name or f"{mesh_obj.name}_Rig", collection)
+    try:
+        arm_obj[AUTORIG_TAG] = json.dumps({k: v for k, v in rig.report.items() if k != "timings"})
+        world = mesh_obj.matrix_world.copy()
+        mesh_obj.parent = arm_obj
+        mesh_obj.matrix_parent_inverse = arm_obj.matrix_world.inverted()
+        mesh_obj.matrix_world = world
+        note = ""
+        if weights == "HEAT":
+            note = _heat_weights(context, mesh_obj, arm_obj, rig)
+        else:
+            assign_weights(mesh_obj, rig)
+        if not any(m.type == "ARMATURE" for m in mesh_obj.modifiers):
+            mod = mesh_obj.modifiers.new("Armature", "ARMATURE")
+            mod.object = arm_obj
+    except Exception:
+        bpy.data.objects.remove(arm_obj)  # leave the scene as it was
+        raise
+    return arm_obj, rig, rig.summary() + note
+
+
+class KINECT_RETARGET_OT_autorig_mesh(bpy.types.Operator):
+    """Build a Kinect-named armature for the active humanoid mesh in its current pose, with skin weights,
+    ready for takes and live streams"""
+
+    bl_idname = "kinect_retarget.autorig_mesh"
+    bl_label = "Auto-Rig Mesh"
+    bl_options = {"REGISTER", "UNDO"}
+
+    weights: EnumProperty(name="Weights", items=WEIGHT_ITEMS, default="PROJECTION")
+    levels: IntProperty(name="Levels (K)", description="Topological levels of the paper's skeleton points",
+                        default=4, min=2, max=7)
+    rig_name: StringProperty(name="Armature Name", description="Empty: '<mesh>_Rig'", default="")
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.active_object
+        if obj is None or obj.type != "MESH":
+            cls.poll_message_set("Select a mesh to auto-rig")
+            return False
+        if context.mode != "OBJECT":
+            cls.poll_message_set("Auto-rig works in Object Mode")
+            return False
+        return True
+
+    def execute(self, context):
+        mesh_obj = context.active_object
+        try:
+            arm_obj, _, summary = rig_mesh_object(context, mesh_obj, self.weights, self.levels,
+                                                  self.rig_name or None)
+        except MeshError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        for o in context.view_layer.objects:
+            o.select_set(False)
+        arm_obj.select_set(True)
+        context.view_layer.objects.active = arm_obj
+        self.report({"INFO"}, f"{arm_obj.name}: {summary}")
+        return {"FINISHED"}
+
+
+def _menu(self, context):
+    self.layout.operator(KINECT_RETARGET_OT_autorig_mesh.bl_idname, icon="ARMATURE_DATA")
+
+
+def register_extra() -> None:
+    bpy.types.VIEW3D_MT_object.append(_menu)
+
+
+def unregister_extra() -> None:
+    bpy.types.VIEW3D_MT_object.remove(_menu)
+
+
+CLASSES = (KINECT_RETARGET_OT_autorig_mesh,)
