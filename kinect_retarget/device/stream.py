@@ -150,7 +150,8 @@ class DepthStream:
                 except Exception as exc:                      # keep the thread alive and say what happened
                     log.exception("depth stream failed")
                     self._set(state=ERROR, message=f"unexpected error: {exc!r}", fps=0.0)
-                self._stop.wait(self.reconnect_interval)
+                # errors (no permission, no driver) are retried too, but slowly: the user may be fixing them
+                self._stop.wait(self.reconnect_interval * (4 if self._status.state == ERROR else 1))
         finally:
             self._set(state=STOPPED, message="stopped", fps=0.0, thread_cpu_s=time.thread_time())
 

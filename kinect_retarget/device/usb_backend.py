@@ -201,6 +201,7 @@ def open_iso_pump(device, endpoint: int, transfers: int = DEFAULT_TRANSFERS,
                           f"this one is {type(backend).__name__}")
     size = lib.libusb_get_max_iso_packet_size(handle.devid, endpoint)
     if size <= 0:
-        raise KinectError(f"endpoint {endpoint:#x} reports no isochronous bandwidth (error {size}); "
-                          "on a Kinect for Windows select alternate setting 1 first")
+        # libusb only looks at alt setting 0, which has no bandwidth on a Kinect for Windows: use the slot
+        # size libfreenect uses (macOS hands packets back in 2048-byte slots).
+        size = 2048 if sys.platform == "darwin" else MAX_ISO_PACKET_SIZE
     return LibusbIsoPump(lib, ctx, handle.handle, endpoint, transfers, packets_per_transfer, size)
