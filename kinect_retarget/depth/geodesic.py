@@ -1,10 +1,10 @@
 """Geodesic distances over the person's depth surface (a grid graph cut at depth discontinuities).
 
-Each cell links to its 4 neighbours with the 3D distance between them, or not at all when the depth
-jumps (an arm in front of the chest stays separate from it). Distances are relaxed with whole-row and
-whole-column passes: along a 1D chain, d[i] = S[i] + min_{j<=i}(d[j] - S[j]) with S the running edge
-length, which `np.minimum.accumulate` does for every row at once. A few alternating passes (plus diagonal
-steps) converge to the shortest paths; no Python loop visits a cell.
+Each cell links to its 8 neighbours with the 3D distance between them, or not at all when the depth
+jumps (an arm in front of the chest stays separate from it). Distances are relaxed with whole-line
+passes: along a 1D chain, d[i] = S[i] + min_{j<=i}(d[j] - S[j]) with S the running edge length, which
+`np.minimum.accumulate` does for every row, column or diagonal at once. A few alternating passes converge
+to the shortest paths; no Python loop visits a cell.
 """
 from __future__ import annotations
 
@@ -14,26 +14,47 @@ CUT = 1e4  # an edge at a depth discontinuity costs this much: unreachable in pr
 INF = np.inf
 
 
+def _lines(h: int, w: int, dr: int, dc: int) -> np.ndarray:
+    """Flat cell indices (n_lines, length) of the grid's straight lines in direction (dr, dc); -1 pads."""
+    idx = np.arange(h * w).reshape(h, w)
+    if (dr, dc) == (0, 1):
+        return idx
+    if (dr, dc) == (1, 0):
+        return idx.T.copy()
+    # diagonals: skew so that each diagonal becomes a row
+    flip = idx if dc == 1 else idx[:, ::-1]
+    out = np.full((h + w - 1, min(h, w)), -1, dtype=np.int64)
+    r, c = np.mgrid[0:h, 0:w]
+    k = c - r + (h - 1)
+    pos = np.minimum(r, c)
+    out[k.ravel(), pos.ravel()] = flip.ravel()
+    return out
+
+
 class SurfaceGraph:
+    """The person's surface as a graph on the depth grid: 8-neighbour edges with 3D lengths, cut at depth
+    discontinuities. Each of the 4 line directions (rows, columns, two diagonals) is stored as padded lines
+    with cumulative edge lengths, so one relaxation pass along a direction is a single accumulate."""
+
     def __init__(self, xyz: np.ndarray, mask: np.ndarray, max_jump: float = 0.06):
         self.xyz = xyz
         self.mask = mask
-        z = xyz[..., 2]
-        # edge lengths to the right (h, w-1) and down (h-1, w); CUT where not connected
-        dr = np.linalg.norm(xyz[:, 1:] - xyz[:, :-1], axis=-1)
-        dd = np.linalg.norm(xyz[1:] - xyz[:-1], axis=-1)
-        okr = mask[:, 1:] & mask[:, :-1] & (np.abs(z[:, 1:] - z[:, :-1]) < max_jump)
-        okd = mask[1:] & mask[:-1] & (np.abs(z[1:] - z[:-1]) < max_jump)
-        self.right = np.where(okr, dr, CUT)
-        self.down = np.where(okd, dd, CUT)
-        dg1 = np.linalg.norm(xyz[1:, 1:] - xyz[:-1, :-1], axis=-1)
-        dg2 = np.linalg.norm(xyz[1:, :-1] - xyz[:-1, 1:], axis=-1)
-        self.diag1 = np.where(mask[1:, 1:] & mask[:-1, :-1] & (np.abs(z[1:, 1:] - z[:-1, :-1]) < max_jump), dg1, CUT)
-        self.diag2 = np.where(mask[1:, :-1] & mask[:-1, 1:] & (np.abs(z[1:, :-1] - z[:-1, 1:]) < max_jump), dg2, CUT)
-        # cumulative edge lengths along rows and columns, for the prefix-min passes
         h, w = mask.shape
-        self._srow = np.concatenate([np.zeros((h, 1)), np.cumsum(self.right, axis=1)], axis=1)
-        self._scol = np.concatenate([np.zeros((1, w)), np.cumsum(self.down, axis=0)], axis=0)
+        flat_xyz = xyz.reshape(-1, 3)
+        flat_mask = mask.ravel()
+        self._dirs = []
+        for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
+            lines = _lines(h, w, dr, dc)
+            if lines.shape[1] < 2:
+                continue
+            a, b = lines[:, :-1], lines[:, 1:]
+            real = (a >= 0) & (b >= 0)
+            a0, b0 = np.where(real, a, 0), np.where(real, b, 0)
+            length = np.linalg.norm(flat_xyz[a0] - flat_xyz[b0], axis=-1)
+            ok = real & flat_mask[a0] & flat_mask[b0] & (np.abs(flat_xyz[a0, 2] - flat_xyz[b0, 2]) < max_jump)
+            cum = np.concatenate([np.zeros((lines.shape[0], 1)), np.cumsum(np.where(ok, length, CUT), axis=1)], axis=1)
+            valid = lines >= 0
+            self._dirs.append((np.where(valid, lines, 0), valid, cum))
 
     def distances(self, sources: np.ndarray, init: np.ndarray | None = None, iterations: int = 12) -> np.ndarray:
         """Geodesic distance (h, w) from the source cells (bool mask or (k, 2) row/col); inf off-surface."""
@@ -43,20 +64,17 @@ class SurfaceGraph:
             d[src & self.mask] = 0.0
         elif src.size:
             d[src[:, 0], src[:, 1]] = 0.0
-        d = np.where(np.isfinite(d), d, 1e9)
-        sr, sc = self._srow, self._scol
+        flat = np.where(np.isfinite(d), d, 1e9).ravel()
         for _ in range(iterations):
-            prev = d
-            d = np.minimum(d, sr + np.minimum.accumulate(d - sr, axis=1))                       # left -> right
-            d = np.minimum(d, -sr + np.minimum.accumulate((d + sr)[:, ::-1], axis=1)[:, ::-1])  # right -> left
-            d = np.minimum(d, sc + np.minimum.accumulate(d - sc, axis=0))                       # top -> bottom
-            d = np.minimum(d, -sc + np.minimum.accumulate((d + sc)[::-1], axis=0)[::-1])        # bottom -> top
-            d[1:, 1:] = np.minimum(d[1:, 1:], d[:-1, :-1] + self.diag1)
-            d[:-1, :-1] = np.minimum(d[:-1, :-1], d[1:, 1:] + self.diag1)
-            d[1:, :-1] = np.minimum(d[1:, :-1], d[:-1, 1:] + self.diag2)
-            d[:-1, 1:] = np.minimum(d[:-1, 1:], d[1:, :-1] + self.diag2)
-            if np.array_equal(d, prev):
+            before = flat.copy()
+            for lines, valid, cum in self._dirs:
+                v = np.where(valid, flat[lines], 1e9)
+                v = np.minimum(v, cum + np.minimum.accumulate(v - cum, axis=1))
+                v = np.minimum(v, -cum + np.minimum.accumulate((v + cum)[:, ::-1], axis=1)[:, ::-1])
+                flat[lines[valid]] = v[valid]
+            if np.array_equal(flat, before):
                 break
+        d = flat.reshape(self.mask.shape)
         return np.where((d < CUT * 0.5) & self.mask, d, INF)
 
 

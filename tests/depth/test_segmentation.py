@@ -1,0 +1,61 @@
+"""Segmentation stage: floor from gravity + plane fit, connected components, person choice."""
+from __future__ import annotations
+
+import numpy as np
+
+from kinect_retarget.depth.render import Room, gravity_in_camera, room_depth
+from kinect_retarget.depth.segmentation import DepthGrid, connected_components, find_people, fit_floor
+
+
+def _mm(depth_m):
+    return np.where(np.isfinite(depth_m), np.round(depth_m * 1000), 0).astype(np.uint16)
+
+
+def test_floor_plane_from_gravity_and_fit(camera):
+    for tilt in (0.0, 12.0):
+        depth = room_depth(Room(floor_y=-0.85, back_wall_z=4.0), camera, tilt)
+        g = gravity_in_camera(tilt)
+        grid = DepthGrid.from_mm(_mm(depth), camera)
+        floor = fit_floor(grid, g)
+        assert floor is not None
+        assert np.degrees(np.arccos(np.clip(floor.normal @ -g, -1, 1))) < 1.0
+        assert abs(floor.height(np.zeros(3)) - 0.85) < 0.02      # the camera is 0.85 m above the floor
+        # a wrong gravity guess (level instead of 12 deg) is corrected by the plane fit only within 10 deg
+    depth = room_depth(Room(floor_y=-0.85, back_wall_z=4.0), camera, 6.0)
+    floor = fit_floor(DepthGrid.from_mm(_mm(depth), camera), np.array([0.0, -1.0, 0.0]))
+    assert np.degrees(np.arccos(floor.normal @ -gravity_in_camera(6.0))) < 1.0
+
+
+def test_no_floor_in_view_gives_none(camera):
+    grid = DepthGrid.from_mm(np.zeros((480, 640), np.uint16), camera)
+    assert fit_floor(grid, None) is None
+
+
+def test_connected_components_split_at_depth_steps():
+    z = np.full((30, 40), 2.0)
+    z[:, 20:] = 1.5                                # two surfaces 50 cm apart, touching in the image
+    mask = np.ones_like(z, bool)
+    mask[10:12, :] = False                         # and a gap splitting the top from the bottom
+    lab = connected_components(mask, z, max_jump=0.1)
+    assert len(np.unique(lab[lab >= 0])) == 4
+    assert (lab[~mask] == -1).all()
+    assert len(np.unique(connected_components(mask, z, max_jump=1.0)[mask])) == 2
+
+
+def test_rendered_person_is_found_among_furniture_and_a_bystander(shared_data, camera):
+    from kinect_retarget.depth.synthetic import Scenario, render_sequence
+    seq = render_sequence(str(shared_data / "mocap_bvh" / "131_02.bvh"), str(shared_data / "meshes" / "makehuman"),
+                          Scenario(second_person=(1.2, 3.5), boxes=[((-1.6, -0.9, 2.0), (-0.9, -0.1, 2.6))], seed=1),
+                          frames=1)
+    grid = DepthGrid.from_mm(seq.mm[0], camera)
+    floor = fit_floor(grid, seq.gravity)
+    people = find_people(grid, floor, seq.gravity)
+    assert len(people) >= 2                        # performer and bystander (the box may also pass the size test)
+    hip = seq.joints[0, 0]
+    performer = min(people, key=lambda p: np.linalg.norm(p.centroid - hip))
+    assert np.linalg.norm(performer.centroid[[0, 2]] - hip[[0, 2]]) < 0.2
+    assert 1.3 < performer.height < 1.8
+    from kinect_retarget.depth.tracker import SkeletonTracker
+    tr = SkeletonTracker(gravity=seq.gravity)
+    tr.update(seq.mm[0], 0.0)
+    assert tr.last_mask is not None and np.array_equal(tr.last_mask, performer.mask)
