@@ -15,9 +15,11 @@ import numpy as np
 
 from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED
 from . import body_model_fit as bm
-from .geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
+from .geodesic import SurfaceGraph, geodesic_extrema, geodesic_maxima, level_set_centroid
 
 J = {n: i for i, n in enumerate(KINECT_V1.joints)}
+GEODESIC_ROWS = 1000   # no subsampling below the tracker's grid: coarser cells merge arms with the body
+EXTREMA = "plagemann"     # "maxima" (one geodesic run) or "plagemann" (one run per extremum, slower)
 SIDES = ("Left", "Right")
 
 
@@ -48,10 +50,10 @@ class Projector:
     """Projective agreement between 3D joint hypotheses and the cropped depth surface."""
 
     def __init__(self, grid, crop, xyz, mask):
-        self.grid, self.r0, self.c0, self.xyz, self.mask = grid, crop[0], crop[1], xyz, mask
+        self.grid, self.r0, self.c0, self.k, self.xyz, self.mask = grid, crop[0], crop[1], crop[2], xyz, mask
 
     def cost(self, pts: np.ndarray, inside: float) -> np.ndarray:
-        rc = np.round(self.grid.to_pixel(pts)).astype(np.int64) - [self.r0, self.c0]
+        rc = np.round((self.grid.to_pixel(pts) - [self.r0, self.c0]) / self.k).astype(np.int64)
         h, w = self.mask.shape
         ok = (rc[:, 0] >= 0) & (rc[:, 0] < h) & (rc[:, 1] >= 0) & (rc[:, 1] < w)
         r = np.clip(rc[:, 0], 0, h - 1)
@@ -92,10 +94,14 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
                prev_head_top: np.ndarray | None = None) -> FitResult | None:
     rows, cols = np.nonzero(mask_full)
     r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
-    xyz = grid.xyz[r0:r1, c0:c1]
-    mask = mask_full[r0:r1, c0:c1]
+    # geodesics on a grid about 60 cells tall whatever the distance: constant cost per frame
+    k = max(1, int(round((r1 - r0) / GEODESIC_ROWS)))
+    xyz = grid.xyz[r0:r1:k, c0:c1:k]
+    mask = mask_full[r0:r1:k, c0:c1:k]
+    cell = float(np.median(xyz[mask][:, 2])) * grid.step * k / grid.camera.f   # metres per cell
+    band = lambda w: max(w, 1.5 * cell)
     graph = SurfaceGraph(xyz, mask)
-    proj = Projector(grid, (r0, c0), xyz, mask)
+    proj = Projector(grid, (r0, c0, k), xyz, mask)
     H = calib.height
     # --- torso ---------------------------------------------------------------------------------------
     seed_p = prev_centre if prev_centre is not None else grid.xyz[mask_full].mean(axis=0)
@@ -123,7 +129,8 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
         lat = _unit(lat - (lat @ axis) * axis)
     inside = lambda name: view * bm.DEPTH_INSIDE[name]
     # --- extremities ---------------------------------------------------------------------------------
-    extrema = geodesic_extrema(graph, d0, count=6, min_distance=0.15 * H)
+    extrema = (geodesic_extrema(graph, d0, count=6, min_distance=0.15 * H, iterations=4) if EXTREMA == "plagemann"
+               else geodesic_maxima(xyz, d0, count=6, min_distance=0.15 * H, window=max(3, int(0.12 / cell) | 1)))
     cand = []
     for r, c, dist in extrema:
         p = xyz[r, c]
@@ -148,8 +155,8 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     hands = sorted([e for e in rest if e not in feet and e[3] > -0.35 * H], key=lambda e: -e[2])[:2]
     labels = []
     if head is not None:
-        dh = graph.distances(np.array([head[0]]), iterations=6)
-        hc = level_set_centroid(xyz, dh, 0.06 * H, 0.04, head[1], 0.2)
+        dh = graph.distances(np.array([head[0]]), iterations=3)
+        hc = level_set_centroid(xyz, dh, 0.06 * H, band(0.04), head[1], 0.2)
         pos[J["Head"]] = (hc if hc is not None else head[1] - axis * 0.05 * H) + inside("Head")
         st[J["Head"]] = TRACKED
         labels.append(("head", head[1]))
@@ -170,12 +177,12 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
             a = pos[J[f"{root}{s}"]]
             l1, l2 = r1 * H, r2 * H
             if e is not None:
-                de = graph.distances(np.array([e[0]]), iterations=8)
-                tip_p = level_set_centroid(xyz, de, d_tip, 0.05, e[1], 0.2)
-                end_p = level_set_centroid(xyz, de, d_end, 0.05, e[1], 0.3)
+                de = graph.distances(np.array([e[0]]), iterations=4)
+                tip_p = level_set_centroid(xyz, de, d_tip, band(0.05), e[1], 0.2)
+                end_p = level_set_centroid(xyz, de, d_end, band(0.05), e[1], 0.3)
                 tip_p = (e[1] if tip_p is None else tip_p) + inside(tip)
                 end_p = (tip_p if end_p is None else end_p + inside(end))
-                mid_ls = level_set_centroid(xyz, de, d_end + l2, 0.06, end_p, l2 + 0.1)
+                mid_ls = level_set_centroid(xyz, de, d_end + l2, band(0.06), end_p, l2 + 0.1)
                 labels.append((f"{tip}{s}", e[1]))
                 st_limb = TRACKED
             else:

@@ -14,7 +14,7 @@ def test_tracks_rendered_mocap_within_bound(rendered):
     take = track_depth_frames(seq.mm, seq.times, gravity=seq.gravity)
     sc = score(take.positions, take.states, seq.joints, seq.present)
     assert sc.coverage == 1.0 and sc.nan_frames == 0
-    assert sc.mean_error < 0.12, f"mean joint error {sc.mean_error:.3f} m"
+    assert sc.mean_error < 0.08, f"mean joint error {sc.mean_error:.3f} m"
     assert sc.per_joint[0] < 0.10 and sc.per_joint[3] < 0.10       # hip centre and head
     assert sc.swaps_over_3 == 0
     assert np.mean(take.states == TRACKED) > 0.5
