@@ -56,6 +56,9 @@ class FrameAssembler:
         self._lost = 0
         self._holes: list = []
         self._timestamp = 0
+        self._abs = 0                  # packets since the stream began, counted by sequence number
+        self._last_seq: int | None = None
+        self._anchor: tuple[int, int] | None = None   # (abs index, timestamp) of the last start-of-frame
         self._last_delivered: int | None = None
         self._buf = bytearray()
 
@@ -117,6 +120,22 @@ class FrameAssembler:
         self._last_delivered = self._timestamp
         return AssembledFrame(buf, self._timestamp, lost, holes)
 
+    def _resync_without_sof(self, flag: int, seq: int) -> bool:
+        """While resyncing, a frame whose start-of-frame (and at most max_gap more) was lost can still be
+        picked up: its position follows from the last start-of-frame seen, 242 packets per frame."""
+        if self._anchor is None:
+            return False
+        since = self._abs - self._anchor[0]
+        pos = since % DEPTH_PACKETS_PER_FRAME
+        last = DEPTH_PACKETS_PER_FRAME - 1
+        if not 0 < pos <= self.max_gap or flag != (FLAG_DEPTH_EOF if pos == last else FLAG_DEPTH_MOF):
+            return False
+        self._start_frame(seq)
+        self._timestamp = (self._anchor[1] + (since // DEPTH_PACKETS_PER_FRAME) * TICKS_PER_FRAME) & 0xFFFFFFFF
+        self._pkt = self._lost = pos
+        self._hole(0, pos)
+        return True
+
     def _skip(self, count: int, seq: int) -> None:
         """Skip `count` packets at the start of a frame: its start-of-frame (and timestamp) was lost, so the
         timestamp follows the previous frame's, which is exact because the previous frame just ended."""
@@ -136,19 +155,29 @@ class FrameAssembler:
         self.stats.packets += 1
         flag, seq = p[3], p[5]
         done = None
+        # Absolute packet count (from sequence numbers), and the last start-of-frame seen: together they
+        # give any packet's position in its frame, even while resyncing.
+        if self._last_seq is not None:
+            step = (seq - self._last_seq) & 0xFF
+            self._abs += step
+            self.stats.packets_lost += step - 1 if step else 0
+        self._last_seq = seq
+        if flag == FLAG_DEPTH_SOF:
+            self._anchor = (self._abs, int.from_bytes(p[8:12], "little"))
         if not self._synced:
-            if flag != FLAG_DEPTH_SOF:
+            if flag == FLAG_DEPTH_SOF:
+                self._start_frame(seq)
+            elif not self._resync_without_sof(flag, seq):
                 return None
-            self._start_frame(seq)
         if seq != self._seq:
             gap = (seq - self._seq) & 0xFF
-            self.stats.packets_lost += gap
             left = DEPTH_PACKETS_PER_FRAME - self._pkt
             if gap > self.max_gap:
                 self._abandon(f"{gap} packets lost")
-                if flag != FLAG_DEPTH_SOF:
+                if flag == FLAG_DEPTH_SOF:
+                    self._start_frame(seq)
+                elif not self._resync_without_sof(flag, seq):
                     return None
-                self._start_frame(seq)
             elif gap >= left:
                 # The frame's tail is missing and this packet belongs to the next frame.
                 self._lost += left

@@ -112,3 +112,15 @@ def test_out_of_place_flag_resyncs(three_frames):
     asm = FrameAssembler()
     frames = asm.feed(packets[:20] + [bytes(bad)] + packets[21:])
     assert len(frames) == 2 and asm.stats.resyncs == 1
+
+
+def test_resync_picks_up_a_frame_whose_start_was_lost(three_frames):
+    images, packets = three_frames
+    clean = FrameAssembler().feed(packets)
+    asm = FrameAssembler()
+    # frame 0 loses 6 packets (dropped, resync); then frame 1 loses its start-of-frame and one more packet
+    frames = asm.feed(packets[:50] + packets[56:PPF] + packets[PPF + 2:])
+    assert [f.lost_packets for f in frames] == [2, 0]
+    assert [f.timestamp for f in frames] == [f.timestamp for f in clean[1:]]
+    assert asm.stats.packets_lost == 8 and asm.stats.frames_dropped == 1
+    np.testing.assert_array_equal(unpack_11bit(frames[1].packed), images[2])

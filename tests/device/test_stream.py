@@ -48,7 +48,7 @@ def test_three_seconds_real_time_every_frame_bit_exact(real_depth):
 
 def test_injected_loss_drops_exactly_the_frames_with_more_than_five_lost(real_depth):
     clock = VirtualClock()
-    faults = Faults(loss_rate=0.003, bursts=[(5, 100, 6), (12, 0, 3), (30, 240, 4)], truncate=[(20, 50, 300)],
+    faults = Faults(loss_rate=0.01, bursts=[(5, 100, 6), (12, 0, 3), (30, 240, 4)], truncate=[(20, 50, 300)],
                     seed=7)
     emu = EmulatedKinect(real_depth, faults=faults, clock=clock)
     stream = DepthStream(emu, queue_size=1000).start()
@@ -59,8 +59,11 @@ def test_injected_loss_drops_exactly_the_frames_with_more_than_five_lost(real_de
     lost = {frame: n for (_, frame), n in emu.last_pump.faulted.items() if frame <= last}
     expected = {k for k in range(last + 1) if lost.get(k, 0) <= 5}
     assert set(got) == expected
-    assert 5 not in got and {12, 20, 30, 31} <= set(got)
-    assert any(0 < lost.get(k, 0) for k in expected - {12, 20, 30, 31})   # random loss hit delivered frames
+    assert 5 not in got and lost[5] >= 6
+    assert lost[12] >= 3 and lost[20] >= 1 and lost[30] >= 2 and lost[31] >= 2
+    assert {20, 30, 31} <= set(got)                   # damaged ends / starts of frames still delivered
+    assert sum(0 < lost.get(k, 0) for k in expected) >= 10   # random loss hit many delivered frames
+    assert len(set(range(last + 1)) - expected) >= 2           # and pushed some frames over the limit
     for k, f in got.items():
         assert f.lost_packets == lost.get(k, 0)
         truth = emu.images[k % len(emu.images)]
