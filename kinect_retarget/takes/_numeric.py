@@ -28,11 +28,12 @@ def field_counts(data: bytes) -> np.ndarray:
     if buf.size == 0:
         return np.zeros(0, dtype=np.int64)
     ws = _WS[buf]
-    starts = ~ws
-    starts[1:] &= ws[:-1]
-    line_of_byte = np.cumsum(buf == 10) - (buf == 10)  # a newline belongs to the line it ends
-    n_lines = int(line_of_byte[-1]) + 1
-    return np.bincount(line_of_byte[starts], minlength=n_lines)
+    starts = np.flatnonzero(~ws[1:] & ws[:-1]) + 1
+    if not ws[0]:
+        starts = np.concatenate([[0], starts])
+    newlines = np.flatnonzero(buf == 10)
+    n_lines = newlines.size + (0 if buf[-1] == 10 else 1)
+    return np.bincount(np.searchsorted(newlines, starts), minlength=n_lines)
 
 
 def parse_table(path: str, data: bytes, ncol: int | None, *, first_line: int = 1,

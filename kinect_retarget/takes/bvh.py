@@ -208,34 +208,39 @@ def _parse_motion_header(path: str, lines: list[str], motion_line: int) -> tuple
 
 # ------------------------------------------------------------------------------------ forward kinematics
 
+def axis_quaternions(angles_deg: np.ndarray, axes: np.ndarray) -> np.ndarray:
+    """(..., 4) quaternions (w, x, y, z) rotating by `angles_deg` (...) about coordinate axes `axes`
+    (broadcast against the angles; 0, 1, 2 = X, Y, Z)."""
+    half = np.radians(angles_deg) / 2
+    q = np.zeros(half.shape + (4,))
+    q[..., 0] = np.cos(half)
+    axes = np.broadcast_to(axes, half.shape)
+    sin = np.sin(half)
+    for a in range(3):
+        q[..., a + 1] = np.where(axes == a, sin, 0.0)
+    return q
+
+
 def _axis_rotations(angles_deg: np.ndarray, axes: np.ndarray) -> np.ndarray:
-    """(..., 3, 3) rotations by `angles_deg` (...) about coordinate axes `axes` (...) ∈ {0, 1, 2}."""
-    a = np.radians(angles_deg)
-    c, s = np.cos(a), np.sin(a)
-    m = np.zeros(a.shape + (3, 3))
-    i = axes
-    j = (axes + 1) % 3
-    k = (axes + 2) % 3
-    idx = np.indices(a.shape)
-    def put(r, col, val):
-        m[(*idx, r, col)] = val
-    put(i, i, 1.0)
-    put(j, j, c)
-    put(k, k, c)
-    put(k, j, s)
-    put(j, k, -s)
-    return m
+    """(..., 3, 3) rotation matrices by `angles_deg` about coordinate axes `axes`."""
+    return quat.to_matrix(axis_quaternions(angles_deg, axes))
+
+
+def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Rotate (F, 3) vectors by (F, 4) unit quaternions (cheaper than building matrices)."""
+    u, w = q[..., 1:], q[..., :1]
+    t = 2.0 * np.cross(u, v)
+    return v + w * t + np.cross(u, t)
 
 
 def _local_transforms(sk: BvhSkeleton, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Per-frame local rotations (F, N, 3, 3) and translations (F, N, 3) from channel values.
+    """Per-frame local rotations (F, N, 4 quaternions) and translations (F, N, 3) from channel values.
 
     Rotation channels compose in the order listed (R = R_first @ R_second @ R_third, column vectors).
     The root's position channels give its position; other joints' position channels add to their OFFSET
     (MakeHuman writes small deltas there).
     """
     f, n = values.shape[0], len(sk.names)
-    rot = np.broadcast_to(np.eye(3), (f, n, 3, 3)).copy()
     trans = np.broadcast_to(sk.offsets, (f, n, 3)).copy()
     # Rotation channels: slot k (0..2) of each joint, padded with zero angles about X.
     slots = np.zeros((n, 3), dtype=np.int64)
@@ -252,14 +257,14 @@ def _local_transforms(sk: BvhSkeleton, values: np.ndarray) -> tuple[np.ndarray, 
             else:
                 trans[:, j, _AXES[c]] += values[:, col]
     padded = np.concatenate([values, np.zeros((f, 1))], axis=1)  # column -1 reads 0
-    for k in range(3):
-        angles = padded[:, cols[:, k]]                          # (F, N)
-        rot = rot @ _axis_rotations(angles, np.broadcast_to(slots[:, k], (f, n)))
+    rot = axis_quaternions(padded[:, cols[:, 0]], slots[:, 0])
+    for k in (1, 2):
+        rot = quat.mul(rot, axis_quaternions(padded[:, cols[:, k]], slots[:, k]))
     return rot, trans
 
 
 def forward_kinematics(sk: BvhSkeleton, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Global positions (F, N, 3) and rotation matrices (F, N, 3, 3) for every joint and frame."""
+    """Global positions (F, N, 3) and rotations (F, N, 4 quaternions) for every joint and frame."""
     rot, trans = _local_transforms(sk, values)
     g_rot = np.empty_like(rot)
     g_pos = np.empty_like(trans)
@@ -268,8 +273,8 @@ def forward_kinematics(sk: BvhSkeleton, values: np.ndarray) -> tuple[np.ndarray,
             g_rot[:, j] = rot[:, j]
             g_pos[:, j] = trans[:, j]
         else:
-            g_rot[:, j] = g_rot[:, p] @ rot[:, j]
-            g_pos[:, j] = g_pos[:, p] + np.einsum("fab,fb->fa", g_rot[:, p], trans[:, j])
+            g_rot[:, j] = quat.mul(g_rot[:, p], rot[:, j])
+            g_pos[:, j] = g_pos[:, p] + _rotate(g_rot[:, p], trans[:, j])
     return g_pos, g_rot
 
 
@@ -297,7 +302,7 @@ def read_bvh_skeleton(path: str | os.PathLike, scale: float | None = None) -> Bv
         raise TakeError(f"{path}:{int(line_numbers[frames])}: more motion lines than 'Frames: {frames}'")
     positions, g_rot = forward_kinematics(sk, values)
     rest, _ = forward_kinematics(sk, np.zeros((1, sk.channel_count)))
-    motion = BvhMotion(path, sk, frame_time, values, positions, quat.from_matrix(g_rot), rest[0])
+    motion = BvhMotion(path, sk, frame_time, values, positions, g_rot, rest[0])
     motion.family, mapping = _family(sk)
     if motion.family is not None:  # unknown skeletons keep the BVH convention, Y up
         motion.up_axis, motion.up_sign = _up_axis(rest[0], mapping)

@@ -74,30 +74,12 @@ def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
     n_frames = whole(need(0, 1, "frame count"), "frame count")
     if n_frames == 0:
         raise TakeError(f"{path}:1: frame count is 0")
-    k = 1
-    joint_line = np.full(n_frames, -1, dtype=np.int64)  # first joint line of the first body, per frame
-    body_count = np.zeros(n_frames, dtype=np.int64)
-    all_joints: list[int] = []                           # first joint line of every body
-    for f in range(n_frames):  # body counts vary per frame: the layout can only be walked in order
-        li = need(k, 1, f"body count of frame {f + 1}")
-        nb = body_count[f] = whole(li, "body count")
-        k += 1
-        for b in range(nb):
-            need(k, BODY_FIELDS, f"body {b + 1} of frame {f + 1}")
-            nj = whole(need(k + 1, 1, "joint count"), "joint count")
-            if nj != len(KINECT_V2):
-                raise TakeError(f"{path}:{int(lines[k + 1]) + 1}: expected 25 joints, found {nj}")
-            if k + 2 + nj > lines.size:
-                raise TakeError(f"{path}:{int(lines[-1]) + 1}: file ends inside frame {f + 1} (truncated?)")
-            all_joints.append(k + 2)
-            if b == 0:
-                joint_line[f] = k + 2
-            k += 2 + nj
-    if k < lines.size:
-        raise TakeError(f"{path}:{int(lines[k]) + 1}: data after the last of the {n_frames} frames "
-                        f"(frame count wrong?)")
+    layout = _layout_fast(counts[lines], flat[start[lines]], n_frames)
+    if layout is None:  # something is off: walk the file in order to name the first bad line
+        layout = _layout_walk(path, lines, counts, n_frames, need, whole)
+    joint_line, body_count, all_joints = layout
     # Every joint line at once: check widths, then gather the first bodies' values.
-    every = lines[(np.asarray(all_joints, dtype=np.int64)[:, None] + np.arange(len(KINECT_V2))).ravel()]
+    every = lines[(all_joints[:, None] + np.arange(len(KINECT_V2))).ravel()]
     bad = counts[every] != JOINT_FIELDS
     if bad.any():
         li = int(every[np.argmax(bad)])
@@ -129,3 +111,56 @@ def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
     return take, {"depth_px": depth, "color_px": color, "orientation": table[..., 7:11],
                   "depth_px_unmirrored": depth * [-1, 1] + [DEPTH_SIZE[0] - 1, 0],
                   "color_px_unmirrored": color * [-1, 1] + [COLOR_SIZE[0] - 1, 0], "body_count": body_count}
+
+
+def _layout_fast(kinds: np.ndarray, first: np.ndarray, n_frames: int):
+    """The frame/body layout from line widths alone (vectorised), or None if it is not consistent."""
+    per_body = 2 + len(KINECT_V2)
+    bodies = np.flatnonzero(kinds == BODY_FIELDS)
+    if np.any(bodies + 1 >= kinds.size) or np.any(first[bodies + 1] != len(KINECT_V2)):
+        return None
+    single = kinds == 1
+    single[0] = False
+    single[bodies + 1] = False
+    heads = np.flatnonzero(single)
+    if heads.size != n_frames:
+        return None
+    nb = first[heads]
+    if np.any((nb < 0) | (nb != np.round(nb))):
+        return None
+    nb = nb.astype(np.int64)
+    nxt = heads + 1 + per_body * nb
+    if np.any(nxt[:-1] != heads[1:]) or nxt[-1] != kinds.size or nb.sum() != bodies.size:
+        return None
+    rank = np.arange(bodies.size) - np.repeat(np.cumsum(nb) - nb, nb)
+    if np.any(np.repeat(heads + 1, nb) + per_body * rank != bodies):
+        return None
+    joint_line = np.where(nb > 0, heads + 3, -1)
+    return joint_line, nb, bodies + 2
+
+
+def _layout_walk(path, lines, counts, n_frames, need, whole):
+    """Walk frame by frame; raises TakeError at the first line that breaks the layout."""
+    k = 1
+    joint_line = np.full(n_frames, -1, dtype=np.int64)  # first joint line of the first body, per frame
+    body_count = np.zeros(n_frames, dtype=np.int64)
+    all_joints: list[int] = []                           # first joint line of every body
+    for f in range(n_frames):  # body counts vary per frame: the layout can only be walked in order
+        li = need(k, 1, f"body count of frame {f + 1}")
+        nb = body_count[f] = whole(li, "body count")
+        k += 1
+        for b in range(nb):
+            need(k, BODY_FIELDS, f"body {b + 1} of frame {f + 1}")
+            nj = whole(need(k + 1, 1, "joint count"), "joint count")
+            if nj != len(KINECT_V2):
+                raise TakeError(f"{path}:{int(lines[k + 1]) + 1}: expected 25 joints, found {nj}")
+            if k + 2 + nj > lines.size:
+                raise TakeError(f"{path}:{int(lines[-1]) + 1}: file ends inside frame {f + 1} (truncated?)")
+            all_joints.append(k + 2)
+            if b == 0:
+                joint_line[f] = k + 2
+            k += 2 + nj
+    if k < lines.size:
+        raise TakeError(f"{path}:{int(lines[k]) + 1}: data after the last of the {n_frames} frames "
+                        f"(frame count wrong?)")
+    return joint_line, body_count, np.asarray(all_joints, dtype=np.int64)

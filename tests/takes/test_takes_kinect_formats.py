@@ -152,3 +152,22 @@ def test_utkinect_repeated_frame_numbers(fixtures, tmp_path):
     (tmp_path / "back.txt").write_text("".join(lines[:5] + [lines[2]] + lines[5:]))
     with pytest.raises(TakeError, match=r"back\.txt:6: frame number 250 comes after 252"):
         utkinect.read(tmp_path / "back.txt")
+
+
+def test_ntu_fast_layout_agrees_with_the_walk(fixtures):
+    """The vectorised layout (used for valid files) gives what the frame-by-frame walk gives."""
+    import warnings
+    from kinect_retarget.takes import _numeric
+    text = _numeric.normalise(fixtures["ntu"].read_bytes())
+    counts = _numeric.field_counts(text)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        flat = np.fromstring(text.decode(), sep=" ")
+    lines = np.flatnonzero(counts)
+    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    fast = ntu_skeleton._layout_fast(counts[lines], flat[start[lines]], 40)
+    assert fast is not None
+    slow = ntu_skeleton._layout_walk("x", lines, counts, 40, lambda k, n, what: int(lines[k]),
+                                     lambda li, what: int(flat[start[li]]))
+    for a, b in zip(fast, slow):
+        np.testing.assert_array_equal(a, b)
