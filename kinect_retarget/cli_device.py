@@ -35,6 +35,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--seconds", type=float, default=5.0, help="how long to record (default 5)")
     p.add_argument("--out", required=True, metavar="DEPTH.npz")
     p.add_argument("--dump", metavar="DUMP", help="also write every isochronous packet as received")
+    p.add_argument("--calibration", metavar="DEPTH.npz",
+                   help="with --replay: take the calibration from an earlier capture of the same Kinect")
     p.add_argument("--serial", help="which Kinect, when several are plugged in")
     p.set_defaults(handler=run_capture)
 
@@ -107,10 +109,20 @@ def _save(path: str, raws, mms, stamps, lost, calibration: Calibration) -> None:
                  **{f"calibration_{k}": v for k, v in calibration.as_dict().items() if k != "source"})
 
 
+def _calibration_from(path: str) -> Calibration:
+    try:
+        with np.load(path) as data:
+            fields = json.loads(str(data["calibration"]))
+        return Calibration(**fields)
+    except (OSError, KeyError, ValueError, TypeError) as exc:
+        raise ValueError(f"{path}: no usable calibration in it ({exc})") from exc
+
+
 def _capture_replay(args) -> int:
     from .device.dump import replay_dump
     frames, assembler, error = replay_dump(args.replay)
-    calibration = Calibration()          # a dump holds packets only: typical calibration values are used
+    # a dump holds packets only: the calibration comes from an earlier capture, else typical values
+    calibration = _calibration_from(args.calibration) if args.calibration else Calibration()
     lut = calibration.raw_to_mm_table()
     raws, mms = zip(*(decode_frame(f, lut) for f in frames)) if frames else ((), ())
     _save(args.out, list(raws), list(mms), [f.timestamp for f in frames], [f.lost_packets for f in frames],
@@ -127,6 +139,8 @@ def _capture_replay(args) -> int:
 def run_capture(args) -> int:
     if args.seconds <= 0 and not args.replay:
         return _fail(ValueError("--seconds must be positive"))
+    if args.calibration and not args.replay:
+        return _fail(ValueError("--calibration only applies to --replay (a live capture reads the device's)"))
     try:
         if args.replay:
             return _capture_replay(args)

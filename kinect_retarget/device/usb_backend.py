@@ -148,10 +148,10 @@ class LibusbIsoPump:
             if ctypes.addressof(transfer.contents) in self._in_flight:
                 self._lib.libusb_cancel_transfer(transfer)
         deadline = time.monotonic() + timeout
-        while self._in_flight and time.monotonic() < deadline and not self._gone:
-            tv = _Timeval(0, 10_000)
+        while self._in_flight and time.monotonic() < deadline:   # after an unplug too: they come back
+            tv = _Timeval(0, 10_000)                                # with NO_DEVICE or CANCELLED
             self._lib.libusb_handle_events_timeout_completed(self._ctx, ctypes.byref(tv), None)
-        if self._in_flight and not self._gone:
+        if self._in_flight:
             # libusb still owns them: freeing would corrupt memory, so keep them (and their buffers) alive.
             self._transfers = [t for t in self._transfers if ctypes.addressof(t.contents) in self._in_flight]
             return

@@ -29,12 +29,16 @@ def test_capture_simulated_with_dump_then_replay(tmp_path, shared_data, capsys):
     assert live["mm"].shape == live["raw"].shape and live["timestamp"].shape == (live["raw"].shape[0],)
     assert json.loads(str(live["calibration"]))["source"] == "device"
     replayed = tmp_path / "replayed.npz"
-    assert main(["capture", "--replay", str(dump), "--out", str(replayed)]) == 0
+    assert main(["capture", "--replay", str(dump), "--out", str(replayed), "--calibration", str(out)]) == 0
     again = np.load(replayed)
+    assert json.loads(str(again["calibration"])) == json.loads(str(live["calibration"]))
     # the dump holds every packet, so offline decoding gives the same frames (and maybe one more at the end)
     n = live["raw"].shape[0]
     np.testing.assert_array_equal(again["raw"][:n], live["raw"])
     np.testing.assert_array_equal(again["timestamp"][:n], live["timestamp"])
+    np.testing.assert_array_equal(again["mm"][:n], live["mm"])
+    assert main(["capture", "--replay", str(dump), "--out", str(replayed), "--calibration", str(dump)]) == 1
+    assert "no usable calibration" in capsys.readouterr().err
 
 
 def test_motor_commands_simulated(capsys):

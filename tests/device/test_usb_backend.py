@@ -122,7 +122,8 @@ def test_unplug_raises_device_gone():
     with pytest.raises(DeviceGone):
         for _ in range(3):
             pump.poll(0.01)
-    pump.stop()                               # must not hang or free transfers libusb still owns
+    pump.stop()                               # waits for libusb to hand every transfer back, then frees
+    assert not lib.pending and len(lib.freed) == 4
 
 
 def test_stop_keeps_transfers_that_libusb_has_not_returned():
