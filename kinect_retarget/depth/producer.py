@@ -1,0 +1,91 @@
+"""Skeleton frames from a (real or emulated) USB Kinect: DepthStream -> SkeletonTracker.
+
+`open_skeleton_producer()` is what the "USB Kinect" live source looks for (sources/usb.py): an object with
+`read(timeout) -> (positions (20, 3), states (20,), time_s) | None`, `skeleton`, `rate`, `close()`.
+The tracker runs on the caller's (source) thread; nothing here touches bpy. `preview()` gives the newest
+depth image with the segmented person and the fitted skeleton, for the sidebar (drawn by the main thread).
+"""
+from __future__ import annotations
+
+import os
+import queue
+import tempfile
+import threading
+from pathlib import Path
+
+import numpy as np
+
+from ..core.skeletons import KINECT_V1
+from .tracker import SkeletonTracker
+
+TICKS_PER_SECOND = 60_000_000
+TICK_WRAP = 1 << 32
+
+
+class DepthSkeletonProducer:
+    skeleton = KINECT_V1
+    rate = 30.0
+
+    def __init__(self, stream, tracker: SkeletonTracker | None = None, own_stream: bool = True):
+        self.stream = stream
+        self.tracker = tracker or SkeletonTracker()
+        self._own = own_stream
+        self._first_tick: int | None = None
+        self._elapsed = 0
+        self._last_tick = 0
+        self._lock = threading.Lock()
+        self._preview = None
+
+    def read(self, timeout: float):
+        try:
+            frame = self.stream.frames.get(timeout=timeout)
+        except queue.Empty:
+            return None
+        if self._first_tick is None:
+            self._first_tick = self._last_tick = frame.timestamp
+        self._elapsed += (frame.timestamp - self._last_tick) % TICK_WRAP   # the device clock wraps at 2**32
+        self._last_tick = frame.timestamp
+        t = self._elapsed / TICKS_PER_SECOND
+        mm = frame.mm if frame.mm is not None else frame.calibration.to_mm(frame.raw)
+        positions, states = self.tracker.update(mm, t)
+        with self._lock:
+            self._preview = (mm, self.tracker.last_mask, positions.copy(), states.copy())
+        return positions, states, t
+
+    def preview(self):
+        """(depth_mm, person mask on the tracker grid or None, positions, states) of the newest frame."""
+        with self._lock:
+            return self._preview
+
+    def close(self) -> None:
+        if self._own:
+            self.stream.stop()
+
+
+def simulated_frames(frames: int = 90, clip: str = "131_03", shared_data: str | None = None) -> list[np.ndarray]:
+    """Raw 11-bit frames of a rendered real motion for the emulated Kinect, cached on disk (rendering
+    takes about half a second per frame the first time)."""
+    from .synthetic import Scenario, render_sequence
+    data = Path(shared_data) if shared_data else Path(__file__).resolve().parents[3] / "shared" / "data"
+    cache = Path(os.environ.get("KR_DEPTH_CACHE", Path(tempfile.gettempdir()) / "kinect_retarget_depth_cache"))
+    cache.mkdir(parents=True, exist_ok=True)
+    path = cache / f"simulate_{clip}_{frames}.npy"
+    if path.exists():
+        return list(np.load(path))
+    bvh = data / "mocap_bvh" / f"{clip}.bvh"
+    if not bvh.exists():
+        raise FileNotFoundError(f"{bvh}: the simulated Kinect renders CMU mocap from the shared data folder")
+    seq = render_sequence(str(bvh), str(data / "meshes" / "makehuman"), Scenario(seed=11), frames=frames)
+    np.save(path, seq.raw)
+    return list(seq.raw)
+
+
+def open_skeleton_producer(source=None, simulate: bool = False, frames: int = 90, gravity=None):
+    """Start a DepthStream (real Kinect, or the emulated one streaming rendered mocap when `simulate`) and
+    return a producer of skeleton frames."""
+    from ..device.stream import DepthStream
+    if simulate and source is None:
+        from ..device.emulated import EmulatedKinect
+        source = EmulatedKinect(simulated_frames(frames))
+    stream = DepthStream(source, queue_size=2).start()   # live wants the newest frame: a short queue
+    return DepthSkeletonProducer(stream, SkeletonTracker(gravity=gravity))

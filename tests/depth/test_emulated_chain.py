@@ -1,0 +1,59 @@
+"""Emulated Kinect end to end: rendered depth -> emulated USB -> driver -> tracker -> skeleton frames -> rig."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from kinect_retarget.core.skeletons import NOT_TRACKED
+
+
+def test_emulated_usb_depth_to_skeleton_frames_to_rig(rendered):
+    from kinect_retarget.device.emulated import EmulatedKinect
+    from kinect_retarget.depth.producer import open_skeleton_producer
+    seq, _ = rendered
+    producer = open_skeleton_producer(EmulatedKinect(list(seq.raw)), gravity=seq.gravity)
+    frames = []
+    deadline = time.monotonic() + 20
+    try:
+        while len(frames) < 8 and time.monotonic() < deadline:
+            f = producer.read(0.1)
+            if f is not None:
+                frames.append(f)
+    finally:
+        producer.close()
+    assert len(frames) == 8
+    times = [t for _, _, t in frames]
+    assert times[0] == 0.0 and np.all(np.diff(times) > 0.03) and np.all(np.diff(times) < 0.04)
+    for positions, states, _ in frames:
+        assert positions.shape == (20, 3) and np.all(np.isfinite(positions))
+        assert np.all(states != NOT_TRACKED)
+    # the stream loops over the rendered frames: the skeletons sit on the performer (hip centre within 15 cm)
+    hips = np.array([p[0] for p, _, _ in frames])
+    assert np.min(np.linalg.norm(hips[:, None] - seq.joints[None, :, 0], axis=-1), axis=1).max() < 0.15
+    mm, mask, pos, st = producer.preview()
+    assert mm.shape == (480, 640) and mask is not None and mask.any()
+    # and the skeleton frames pose a rig through the engine's live pipeline (what live applies each frame):
+    # the posed rig's bones point where the tracked skeleton's bones point
+    from kinect_retarget.core.conventions import kinect_to_blender
+    from kinect_retarget.core.kinect_rig_layout import generated_mapping, generated_rig
+    from kinect_retarget.core.pipeline import RetargetPipeline, RetargetSettings
+    from kinect_retarget.core.skeletons import KINECT_V1
+    from kinect_retarget.core.target_rig import evaluate_pose
+    from kinect_retarget.core.quat import normalize
+    lengths = np.median(np.linalg.norm(np.array([p for p, _, _ in frames])[:, 1:]
+                                       - np.array([p for p, _, _ in frames])[:, KINECT_V1.parent_array[1:]], axis=-1), 0)
+    lengths = np.concatenate([[0.1], lengths])
+    rig = generated_rig(KINECT_V1, lengths)
+    pipe = RetargetPipeline(KINECT_V1, rig, generated_mapping(KINECT_V1), RetargetSettings(filter="none"))
+    poses = [pipe.process_frame(p, s, t) for p, s, t in frames]
+    assert all(pose is not None for pose in poses)
+    quats = np.array([pose.quats for pose in poses])
+    posed = evaluate_pose(rig, pipe.retargeter.bone_indices, quats, pipe.retargeter.root.index,
+                          np.array([pose.root_location for pose in poses]))
+    p = kinect_to_blender(np.array([f[0] for f in frames]))
+    knee, ankle = KINECT_V1.index("KneeLeft"), KINECT_V1.index("AnkleLeft")
+    shin = next(m for m in pipe.retargeter.mapped if (m.head, m.tail) == (knee, ankle))
+    got = normalize(posed[:, shin.index, :3, 1] @ rig.object_rotation.T)
+    want = normalize(p[:, ankle] - p[:, knee])
+    assert np.all(np.sum(got * want, -1) > np.cos(np.radians(2)))
