@@ -105,7 +105,7 @@ def autorig(mesh: Mesh, levels: int = LEVELS) -> AutoRig:
     others = np.setdiff1d(np.arange(len(mesh.vertices)), body)
     if len(others):
         seg_all[others] = segment[_nearest(mesh.vertices[others], v)]
-    index, weight = bone_projection_weights(mesh.vertices, seg_all, joints, height)
+    index, weight = bone_projection_weights(mesh.vertices, seg_all, joints, height, graph)
     timings["weights"] = time.perf_counter() - t0
     report = {"body_vertices": int(len(body)), "components": int(comp.max()) + 1,
               "bound_vertices": int(len(others)), "feature_points": {l: v[i].tolist() for l, i in zip(LABELS, fp.vertices)},

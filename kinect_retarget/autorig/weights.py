@@ -8,6 +8,7 @@ from ..core.skeletons import KINECT_V1
 
 MAX_INFLUENCES = 4
 FALLOFF = 4.0  # weight ~ 1 / distance**FALLOFF: joints blend over a short span, bones stay rigid between
+OUTER_HALF = 0.5  # shoulder and hip bones pull skin only along their outer half
 
 # Which bones (named after their tail joint, as the generated Kinect rig names them) each body segment may
 # use: an arm never pulls the thigh it hangs beside. Segments in features.LABELS order.
@@ -27,6 +28,13 @@ SEGMENT_BONES = (
     ("HipCenter", "Spine") + _side(_LEG, "Left"),
     ("HipCenter", "Spine") + _side(_LEG, "Right"),
 )
+
+
+# Bones each segment owns; the other allowed bones are weighed down by FOREIGN so they only take skin that
+# is right at them (the armpit, the groin) and the chest does not ride on a raised arm.
+_OWN = (_TRUNK + _side(("ShoulderSIDE", "HipSIDE"), "Left") + _side(("ShoulderSIDE", "HipSIDE"), "Right"),
+        _side(_ARM, "Left"), _side(_ARM, "Right"), _side(_LEG, "Left"), _side(_LEG, "Right"))
+FOREIGN = 0.1
 
 
 def bone_segments(joints: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -50,19 +58,60 @@ def point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.nd
     return np.linalg.norm(p[:, None, :] - closest, axis=2)
 
 
-def bone_projection_weights(vertices: np.ndarray, segment: np.ndarray, joints: np.ndarray,
-                            height: float) -> tuple[np.ndarray, np.ndarray]:
-    """(V, 4) bone indices (KINECT_V1 order) and (V, 4) weights summing to 1 (unused slots weigh 0)."""
+def projection_matrix(vertices: np.ndarray, segment: np.ndarray, joints: np.ndarray,
+                      height: float) -> np.ndarray:
+    """(V, 20) raw bone-projection weights, each row summing to 1."""
     heads, tails = bone_segments(joints)
+    # The shoulder and hip bones run across the chest and pelvis; only their outer halves pull skin, so
+    # the chest and the pelvis follow the trunk and do not crease at the midline when one arm rises.
+    for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
+        j = KINECT_V1.index(name)
+        heads[j] = heads[j] + OUTER_HALF * (tails[j] - heads[j])
     d = point_segment_distance(vertices, heads, tails) + 1e-3 * height  # no division by zero on a bone
-    allowed = np.zeros((len(SEGMENT_BONES), len(KINECT_V1)), dtype=bool)
+    allowed = np.zeros((len(SEGMENT_BONES), len(KINECT_V1)))
     for s, names in enumerate(SEGMENT_BONES):
-        allowed[s, [KINECT_V1.index(n) for n in names]] = True
-    w = np.where(allowed[segment], (d / height) ** -FALLOFF, 0.0)
+        allowed[s, [KINECT_V1.index(n) for n in names]] = FOREIGN
+        allowed[s, [KINECT_V1.index(n) for n in _OWN[s]]] = 1.0
+    w = allowed[segment] * (d / height) ** -FALLOFF
+    return w / w.sum(axis=1, keepdims=True)
+
+
+def smooth_over_surface(w: np.ndarray, indptr: np.ndarray, indices: np.ndarray, iterations: int) -> np.ndarray:
+    """Jacobi steps of w <- (w + mean of neighbours) / 2 over the CSR adjacency: blends the hard switch
+    where two bones' projections meet over a few edge lengths (shoulder, ankle, groin)."""
+    deg = np.diff(indptr)
+    has = deg > 0
+    starts = indptr[:-1][has]
+    for _ in range(iterations):
+        acc = np.add.reduceat(w[indices], starts, axis=0) if len(indices) else np.zeros((0, w.shape[1]))
+        mean = w.copy()
+        mean[has] = acc / deg[has, None]
+        w = 0.5 * (w + mean)
+    return w
+
+
+def smoothing_iterations(edge_lengths: np.ndarray, height: float, blend: float = 0.03) -> int:
+    """Steps that diffuse over about `blend` x height (diffusion spreads as the square root of steps)."""
+    e = float(np.median(edge_lengths)) if len(edge_lengths) else height
+    return int(np.clip((blend * height / max(e, 1e-12)) ** 2, 2, 40))
+
+
+def top_influences(w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(V, 4) strongest bones and their weights, renormalized to sum to 1."""
     top = np.argsort(-w, axis=1)[:, :MAX_INFLUENCES]
     tw = np.take_along_axis(w, top, axis=1)
     tw /= tw.sum(axis=1, keepdims=True)
     return top, tw
+
+
+def bone_projection_weights(vertices: np.ndarray, segment: np.ndarray, joints: np.ndarray, height: float,
+                            graph=None) -> tuple[np.ndarray, np.ndarray]:
+    """(V, 4) bone indices (KINECT_V1 order) and (V, 4) weights summing to 1 (unused slots weigh 0).
+    With the mesh graph, the weights are smoothed along the surface before the top four are kept."""
+    w = projection_matrix(vertices, segment, joints, height)
+    if graph is not None and len(graph.edges):
+        w = smooth_over_surface(w, graph.indptr, graph.indices, smoothing_iterations(graph.lengths, height))
+    return top_influences(w)
 
 
 def dense_weights(index: np.ndarray, weight: np.ndarray, bones: int) -> np.ndarray:

@@ -208,3 +208,35 @@ def unregister_extra() -> None:
 
 
 CLASSES = (KINECT_RETARGET_OT_autorig_mesh,)
+
+
+def autorig_to_file(mesh: Mesh, out_path: str, *, take=None, render_dir: str | None = None, frames: int = 6,
+                    weights: str = "PROJECTION") -> dict:
+    """Headless: a fresh scene holding `mesh` rigged (and `take` baked on it), saved to out_path."""
+    import os
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    context = bpy.context
+    scene = context.scene
+    obj = new_mesh_object(mesh.name, mesh.vertices, mesh.faces, scene.collection)
+    context.view_layer.objects.active = obj
+    arm, rig, summary = rig_mesh_object(context, obj, weights)
+    out = {"out": out_path, "mesh": obj.name, "armature": arm.name, "vertices": len(mesh.vertices),
+           "height_m": round(float(np.ptp(mesh.vertices[:, 2])), 4), "summary": summary}
+    render_frames = [scene.frame_current]
+    if take is not None:
+        from .bake_take import bake_take
+        messages: list[str] = []
+        result = bake_take(arm, take, preset="kinect", report=lambda level, msg: messages.append(msg))
+        first, last = result.frame_range
+        render_frames = sorted({int(f) for f in np.linspace(first, last, max(1, frames))})
+        out.update({"action": result.action.name, "frames": len(result.motion.frames),
+                    "frame_range": [first, last], "bake": messages[-1] if messages else ""})
+    if render_dir:
+        from .render import stage_and_render
+        os.makedirs(render_dir, exist_ok=True)
+        note = f"auto-rigged {obj.name}" + (f" + {take.metadata.get('name', 'take')}" if take is not None else "")
+        out["renders"] = stage_and_render(scene, [obj], render_frames, render_dir, obj.name, note=note)
+    os.makedirs(os.path.dirname(os.path.abspath(out_path)), exist_ok=True)
+    bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out_path), check_existing=False)
+    return out
