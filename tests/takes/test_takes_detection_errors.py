@@ -165,3 +165,32 @@ def test_corrupted_kinectron(shared_data, tmp_path):
 def test_readers_registered():
     assert {"krtake", "bvh", "kinect_v2_csv", "kinectron_json", "ntu_skeleton", "msrc12",
             "utkinect", "uiprmd"} <= set(READERS)
+
+
+def test_nothing_tracked_in_converted_formats(tmp_path, shared_data):
+    """A file whose every frame is empty is an error, not an empty take, in every Kinect format."""
+    from kinect_retarget.core.skeletons import NOT_TRACKED
+    from kinect_retarget.takes import kinect_v2_csv
+    take = kinect_v2_csv.read(shared_data / "kinect_v2" / "Ges03_drawlines.csv").slice(slice(0, 12))
+    take.states[:] = NOT_TRACKED
+    fx.write_ntu(take, tmp_path / "none.skeleton")
+    fx.write_msrc12(fx.v1_from_v2(take), tmp_path / "none_msrc.csv")
+    fx.write_utkinect(fx.v1_from_v2(take), tmp_path / "none_ut.txt")
+    for name, pattern in (("none.skeleton", "no tracked body in any of its 12 frames"),
+                          ("none_msrc.csv", "no joint is tracked in any frame"),
+                          ("none_ut.txt", "no joint is tracked in any frame")):
+        with pytest.raises(TakeError, match=name.replace(".", r"\.") + ": " + pattern):
+            load_take(tmp_path / name)
+
+
+def test_empty_json_and_uiprmd(tmp_path):
+    for name in ("empty.json", "m01_s01_e01_positions.txt"):
+        (tmp_path / name).write_text("")
+        with pytest.raises(TakeError, match=name.replace(".", r"\.") + ": file is empty"):
+            load_take(tmp_path / name)
+    (tmp_path / "list.json").write_text("[]")
+    with pytest.raises(TakeError, match=r"list\.json: unknown take format"):
+        load_take(tmp_path / "list.json")
+    from kinect_retarget.takes import kinectron_json
+    with pytest.raises(TakeError, match=r"list\.json: recording has no frames"):
+        kinectron_json.read(tmp_path / "list.json")
