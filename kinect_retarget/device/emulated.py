@@ -1,8 +1,8 @@
 """An emulated Kinect v1, as a pyusb backend (usb.backend.IBackend).
 
 It enumerates the camera (and, for the 1414, the motor; for the 1473 and Kinect for Windows, the audio
-bootloader) with real descriptors, answers the GM/RB command protocol with register state, stalls on
-malformed commands as the device's control pipe would, drives a tilt motor with an accelerometer, and
+chip) with real descriptors (emulated_usb.py), answers the GM/RB command protocol with register state, stalls on
+malformed commands as the device's control pipe would, drives a tilt motor with an accelerometer (emulated_motor.py), and
 streams depth built from a sequence of depth images through the iso seam (emulated_stream.py), with fault
 injection. The driver runs unchanged against it: only the iso seam has an emulated implementation.
 """
@@ -11,7 +11,6 @@ from __future__ import annotations
 import array
 import errno
 import itertools
-import math
 import struct
 import threading
 import time
@@ -22,62 +21,24 @@ import usb.backend
 from usb.core import USBError
 
 from . import protocol as P
-from .protocol import TICKS_PER_FRAME
 from .depth_unpack import pack_11bit
+from .emulated_motor import EmulatedMotor, Rejected
 from .emulated_stream import DepthPacketizer, EmulatedIsoPump, Faults, VirtualClock
+from .emulated_usb import UsbFunction, build_functions
+from .protocol import TICKS_PER_FRAME
 
 LIBUSB_ERROR_PIPE = -9
 LIBUSB_ERROR_NO_DEVICE = -4
 LIBUSB_ERROR_ACCESS = -3
+LIBUSB_ERROR_TIMEOUT = -7
 DEFAULT_SERIAL = "A00366A08793039A"
 CONST_SHIFT = 200
 FIXED_PARAMS = (7.5, 2.4, 120.0, 0.1052)       # emitter dist (cm), rcmos dist (cm), ref dist (mm), pixel (mm)
-MOTOR_DEG_PER_S = 15.0                          # emulated slew rate
-COUNTS_PER_G = 819
-
-
-class _Desc:
-    def __init__(self, **fields):
-        self.__dict__.update(fields)
-
-
-def _endpoint(address: int, max_packet: int) -> _Desc:
-    return _Desc(bLength=7, bDescriptorType=5, bEndpointAddress=address, bmAttributes=0x01,
-                 wMaxPacketSize=max_packet, bInterval=1, bRefresh=0, bSynchAddress=0, extra_descriptors=[])
-
-
-def _interface(number: int, alt: int, endpoints: list, cls: int = 0xFF) -> _Desc:
-    return _Desc(bLength=9, bDescriptorType=4, bInterfaceNumber=number, bAlternateSetting=alt,
-                 bNumEndpoints=len(endpoints), bInterfaceClass=cls, bInterfaceSubClass=0xFF,
-                 bInterfaceProtocol=0xFF, iInterface=0, extra_descriptors=[], endpoints=endpoints)
-
-
-@dataclass
-class _UsbFunction:
-    """One USB device of the Kinect (camera, motor or audio)."""
-    kind: str
-    product_id: int
-    bcd_device: int
-    product: str
-    serial: str | None
-    interfaces: list            # [interface number][alt setting] -> _Desc
-    port_numbers: tuple
-    address: int = 0
-
-    def device_descriptor(self, bus: int) -> _Desc:
-        return _Desc(bLength=18, bDescriptorType=1, bcdUSB=0x0200, bDeviceClass=0, bDeviceSubClass=0,
-                     bDeviceProtocol=0, bMaxPacketSize0=64, idVendor=P.VENDOR_MICROSOFT,
-                     idProduct=self.product_id, bcdDevice=self.bcd_device, iManufacturer=1, iProduct=2,
-                     iSerialNumber=3 if self.serial else 0, bNumConfigurations=1, address=self.address,
-                     bus=bus, port_number=self.port_numbers[-1], port_numbers=self.port_numbers, speed=3)
-
-    def strings(self) -> dict[int, str]:
-        return {1: "Microsoft", 2: self.product, 3: self.serial or ""}
 
 
 @dataclass
 class _Handle:
-    function: _UsbFunction
+    function: UsbFunction
     generation: int
     claimed: set = field(default_factory=set)
     alt: dict = field(default_factory=dict)
@@ -118,7 +79,7 @@ class EmulatedKinect(usb.backend.IBackend):
         self._stream_ids = itertools.count(1)
         self._first_start: float | None = None
         self._manual_plugged = True
-        self.functions = self._build_functions(model, serial, audio_firmware)
+        self.functions = build_functions(model, serial, audio_firmware)
         self._bulk_replies: list[bytes] = []
         self._assign_addresses()
         self._power_on()
@@ -138,39 +99,6 @@ class EmulatedKinect(usb.backend.IBackend):
         _, frame = self.expected_frame(timestamp)
         return self.images[frame % len(self.images)]
 
-    # --- topology ----------------------------------------------------------------------------------------
-    @staticmethod
-    def _build_functions(model: str, serial: str, audio_firmware: bool) -> list[_UsbFunction]:
-        iso = P.MAX_ISO_PACKET_SIZE // 2 | (1 << 11)             # 960 bytes x 2 transactions per microframe
-        camera_alt0 = _interface(0, 0, [_endpoint(P.VIDEO_ENDPOINT, iso), _endpoint(P.DEPTH_ENDPOINT, iso)])
-        if model == "1414":
-            camera = _UsbFunction("camera", P.PID_CAMERA, P.BCD_MODEL_1414, "Xbox NUI Camera", serial,
-                                  [[camera_alt0]], (1, 1))
-            motor = _UsbFunction("motor", P.PID_MOTOR, 0x0107, "Xbox NUI Motor", None,
-                                 [[_interface(0, 0, [])]], (1, 2))
-            return [motor, camera]
-        if model not in ("1473", "k4w"):
-            raise ValueError(f"unknown Kinect model {model!r}: use '1414', '1473' or 'k4w'")
-        if model == "1473":
-            camera = _UsbFunction("camera", P.PID_CAMERA, 0x0110, "Xbox NUI Camera", "0000000000000000",
-                                  [[camera_alt0]], (1, 1))
-            audio_pid = P.PID_AUDIO
-        else:   # Kinect for Windows: alt setting 0 has zero-bandwidth endpoints, alt 1 streams
-            alt0 = _interface(0, 0, [_endpoint(P.VIDEO_ENDPOINT, 0), _endpoint(P.DEPTH_ENDPOINT, 0)])
-            alt1 = _interface(0, 1, [_endpoint(P.VIDEO_ENDPOINT, iso), _endpoint(P.DEPTH_ENDPOINT, iso)])
-            camera = _UsbFunction("camera", P.PID_CAMERA_K4W, 0x0100, "Kinect for Windows Camera",
-                                  "0000000000000000", [[alt0, alt1]], (1, 1))
-            audio_pid = P.PID_AUDIO_K4W
-        # Audio chip: in its bootloader it has one interface and no motor/LED; with the (proprietary) audio
-        # firmware running it has more, and takes motor commands on bulk endpoints 0x01/0x81.
-        interfaces = [[_interface(0, 0, [_endpoint(0x81, 512), _endpoint(0x01, 512)])]]
-        if audio_firmware:
-            interfaces.append([_interface(1, 0, [_endpoint(0x82, 512)], cls=0x01)])
-        audio = _UsbFunction("audio", audio_pid, 0x0100, "Xbox Kinect Audio", serial, interfaces, (1, 3))
-        for desc in interfaces[0][0].endpoints:
-            desc.bmAttributes = 0x02                                  # bulk
-        return [camera, audio]
-
     def _assign_addresses(self) -> None:
         for fn in self.functions:
             fn.address = next(self._addresses)
@@ -180,10 +108,7 @@ class EmulatedKinect(usb.backend.IBackend):
         self.depth_stream: _DepthStreamState | None = None
         self._pending_reply: bytes | None = None
         self._reply_delay = 0
-        self.led = 1
-        self.tilt_deg = 0.0
-        self._tilt_target = 0.0
-        self._tilt_since = self.clock()
+        self.motor = EmulatedMotor(self.clock)
 
     # --- plug state --------------------------------------------------------------------------------------
     def _scheduled_plugged(self) -> bool:
@@ -236,9 +161,7 @@ class EmulatedKinect(usb.backend.IBackend):
     def get_configuration_descriptor(self, dev, config):
         if config != 0:
             raise IndexError(config)
-        return _Desc(bLength=9, bDescriptorType=2, wTotalLength=0, bNumInterfaces=len(dev.interfaces),
-                     bConfigurationValue=1, iConfiguration=0, bmAttributes=0x80, bMaxPower=250,
-                     extra_descriptors=[])
+        return dev.configuration_descriptor()
 
     def get_interface_descriptor(self, dev, intf, alt, config):
         return dev.interfaces[intf][alt]          # IndexError past the last alt setting, as pyusb expects
@@ -309,7 +232,7 @@ class EmulatedKinect(usb.backend.IBackend):
         data[:n] = array.array("B", payload[:n])
         return n
 
-    def _string_descriptor(self, fn: _UsbFunction, index: int, data) -> int:
+    def _string_descriptor(self, fn: UsbFunction, index: int, data) -> int:
         if index == 0:
             return self._fill(data, bytes([4, 3, 0x09, 0x04]))
         text = fn.strings().get(index)
@@ -390,67 +313,30 @@ class EmulatedKinect(usb.backend.IBackend):
             self.depth_starts += 1
 
     def _motor_control(self, rtype, request, value, data) -> int:
-        self._advance_motor()
-        if rtype == 0x40 and request == 0x31:
-            angle = struct.unpack("<h", struct.pack("<H", value & 0xFFFF))[0] / 2.0
-            self._tilt_target = max(-27.0, min(27.0, angle))
-            return 0
-        if rtype == 0x40 and request == 0x06:
-            if value not in (0, 1, 2, 3, 4, 5, 6):
-                self._stall()
-            self.led = value
-            return 0
-        if rtype == 0xC0 and request == 0x32:
-            return self._fill(data, self._motor_state())
-        if rtype == 0xC0 and request == 0x10:
-            return self._fill(data, b"\x22")
-        self._stall()
+        try:
+            reply = self.motor.control(rtype, request, value)
+        except Rejected:
+            self._stall()
+        return 0 if reply is None else self._fill(data, reply)
 
-    def _advance_motor(self) -> None:
-        now = self.clock()
-        step = MOTOR_DEG_PER_S * (now - self._tilt_since)
-        self._tilt_since = now
-        d = self._tilt_target - self.tilt_deg
-        self.tilt_deg = self._tilt_target if abs(d) <= step else self.tilt_deg + math.copysign(step, d)
-
-    def _motor_state(self) -> bytes:
-        theta = math.radians(self.tilt_deg)
-        ax, ay, az = 0, round(COUNTS_PER_G * math.cos(theta)), round(COUNTS_PER_G * math.sin(theta))
-        moving = self.tilt_deg != self._tilt_target
-        status = 4 if moving else (1 if abs(self.tilt_deg) >= 27.0 else 0)
-        return struct.pack(">2xhhhbB", ax, ay, az, round(self.tilt_deg * 2), status)
-
-    # --- audio-chip motor commands (bulk) ---------------------------------------------------------------------
+    # --- audio-chip motor commands (bulk; only with the audio firmware running) ----------------------------
     def bulk_write(self, dev_handle, ep, intf, data, timeout):
         with self._lock:
             self.check_handle(dev_handle)
             fn = dev_handle.function
-            if fn.kind != "audio" or len(fn.interfaces) < 2 or ep != 0x01 or len(data) < 16:
+            if fn.kind != "audio" or len(fn.interfaces) < 2 or ep != 0x01:
                 self._stall()
-            magic, tag, arg1, cmd = struct.unpack_from("<4I", bytes(data))
-            arg2 = struct.unpack_from("<i", bytes(data), 16)[0] if len(data) >= 20 else 0
-            status = 0 if magic == 0x06022009 else 1
-            self._advance_motor()
-            if status == 0 and cmd == 0x803B:
-                self._tilt_target = max(-27.0, min(27.0, float(arg2)))
-            elif status == 0 and cmd == 0x10:
-                self.led = arg2
-            elif status == 0 and cmd == 0x8032:
-                theta = math.radians(self.tilt_deg)
-                body = bytearray(104)
-                struct.pack_into("<4i", body, 16, 0, round(COUNTS_PER_G * math.cos(theta)),
-                                 round(COUNTS_PER_G * math.sin(theta)), round(self.tilt_deg))
-                self._bulk_replies.append(bytes(body))
-            elif status == 0:
-                status = 2
-            self._bulk_replies.append(struct.pack("<3I", 0x0A6FE000, tag, status))
+            try:
+                self._bulk_replies += self.motor.audio_command(bytes(data))
+            except Rejected:
+                self._stall()
             return len(data)
 
     def bulk_read(self, dev_handle, ep, intf, buff, timeout):
         with self._lock:
             self.check_handle(dev_handle)
             if ep != 0x81 or not self._bulk_replies:
-                raise USBError("Operation timed out", -7, errno.ETIMEDOUT)
+                raise USBError("Operation timed out", LIBUSB_ERROR_TIMEOUT, errno.ETIMEDOUT)
             return self._fill(buff, self._bulk_replies.pop(0))
 
     # --- the iso seam -------------------------------------------------------------------------------------

@@ -25,7 +25,7 @@ def test_1414_tilt_led_and_accelerometer(real_depth, clock):
     # gravity seen by a sensor pitched up by 27 degrees
     np.testing.assert_allclose(state.accel_g, [0, np.cos(np.radians(27)), np.sin(np.radians(27))], atol=2e-3)
     motor.set_led("red")
-    assert emu.led == 2
+    assert emu.motor.led == 2
     with pytest.raises(ValueError, match="purple"):
         motor.set_led("purple")
     assert set_tilt(-10.4, emu) == -10.4
@@ -53,7 +53,7 @@ def test_1473_with_audio_firmware_uses_bulk_commands(real_depth, clock):
     assert state.tilt_deg == -15.0
     np.testing.assert_allclose(state.accel_g[1], np.cos(np.radians(15)), atol=2e-3)
     motor.set_led("green")
-    assert emu.led == 3                               # the audio chip's code for solid green
+    assert emu.motor.led == 3                               # the audio chip's code for solid green
 
 
 def test_clamp_rejects_nan():

@@ -3,7 +3,6 @@ import queue
 import time
 
 import numpy as np
-import pytest
 
 from kinect_retarget.device.emulated import EmulatedKinect
 from kinect_retarget.device.emulated_stream import Faults, VirtualClock
