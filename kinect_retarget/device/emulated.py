@@ -85,6 +85,7 @@ class EmulatedKinect(usb.backend.IBackend):
         self._power_on()
         self.depth_starts = 0                   # how many times the depth stream was started
         self.streams: list[DepthPacketizer] = []
+        self.register_log: list[tuple[int, int, bool]] = []   # (reg, value, iso transfers were queued)
 
     def expected_frame(self, timestamp: int) -> tuple[int, int]:
         """(stream number, frame number in that stream) that a delivered frame's timestamp belongs to."""
@@ -294,6 +295,8 @@ class EmulatedKinect(usb.backend.IBackend):
 
     def _write_register(self, reg: int, value: int) -> None:
         self.registers[reg] = value
+        pump = getattr(self, "last_pump", None)
+        self.register_log.append((reg, value, bool(pump and pump.running)))
         if reg != P.REG_DEPTH_STREAM:
             return
         if value == 0:

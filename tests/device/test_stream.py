@@ -6,6 +6,7 @@ import numpy as np
 
 from kinect_retarget.device.emulated import EmulatedKinect
 from kinect_retarget.device.emulated_stream import Faults, VirtualClock
+from kinect_retarget.device import protocol as P
 from kinect_retarget.device.protocol import TICKS_PER_FRAME
 from kinect_retarget.device.stream import STOPPED, STREAMING, UNPLUGGED, DepthStream
 
@@ -109,6 +110,9 @@ def test_stop_ends_the_thread_and_releases_the_device(real_depth):
     assert stream.stop(timeout=2.0)
     assert not stream.running and stream.status.state == STOPPED
     assert emu.depth_stream is None                # the driver sent the stop sequence
+    writes = [(reg, value) for reg, value, _ in emu.register_log]
+    assert writes == list(P.DEPTH_START_SEQUENCE + P.DEPTH_STOP_SEQUENCE)
+    assert all(queued for _, _, queued in emu.register_log[:-1])   # iso transfers queued before the start
 
 
 def test_waiting_for_a_device_that_is_not_there(real_depth):
