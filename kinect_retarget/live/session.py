@@ -14,6 +14,7 @@ from typing import Callable
 import numpy as np
 
 from ..core.skeletons import NOT_TRACKED
+from .batching import process_batch
 from .calibration import CalibrationCapture
 from .queueing import FrameQueue
 from .recording import Recorder
@@ -106,36 +107,46 @@ class LiveSession:
         if not self.running:
             return False
         frames = self.queue.drain()
-        newest = None
-        for frame in frames:
+        times = np.empty(len(frames))
+        last_tracked, lost = None, None
+        for k, frame in enumerate(frames):
             self.stats.received += 1
             self.stats.rate.add(frame.arrival)
             ts = self._session_time(frame)
             if self.recorder is not None:
-                t = self.recorder.write(ts, frame.positions, frame.states)  # exactly the stored time
+                times[k] = self.recorder.write(ts, frame.positions, frame.states)  # exactly the stored time
                 self.stats.recorded += 1
             else:
-                t = ts - self._pipe_offset
+                times[k] = ts - self._pipe_offset
             if self._calibration is not None and self._calibration[0].add(ts, frame.positions, frame.states):
                 capture, done = self._calibration
                 self._calibration = None
                 done(capture)
-            try:
-                pose = self.pipeline.process_frame(frame.positions, frame.states, t)
-            except Exception as exc:  # the engine names the problem; live must stop, not crash the host
-                self.stop(f"retarget failed on frame {self.stats.received}: {exc}")
-                return False
             tracked = int(np.count_nonzero(frame.states != NOT_TRACKED))
-            if pose is None or tracked == 0:
+            if tracked == 0:
                 self.stats.untracked += 1
-                if self._lost_tracking(ts):
-                    return False
+                lost = lost or self._lost_tracking(ts)  # stop after the loop: every drained frame is recorded
                 continue
             self._last_tracked_time = ts
             self.last_tracked_joints = tracked
-            if newest is not None:
+            if last_tracked is not None:
                 self.stats.superseded += 1
-            newest = (frame, pose)
+            last_tracked = frame
+        if lost:
+            self.stop(lost)
+            return False
+        newest = None
+        if last_tracked is not None:
+            try:
+                pose = process_batch(self.pipeline, np.stack([f.positions for f in frames]),
+                                     np.stack([f.states for f in frames]), times)
+            except Exception as exc:  # the engine names the problem; live must stop, not crash the host
+                self.stop(f"retarget failed near frame {self.stats.received}: {exc}")
+                return False
+            if pose is not None:
+                newest = (last_tracked, pose)
+        if not self.running:
+            return False
         if newest is not None:
             frame, pose = newest
             if self.clock() - frame.arrival > self.stale_after:
@@ -163,13 +174,12 @@ class LiveSession:
             self._t0_session = frame.arrival - self.start_clock
         return self._t0_session + (frame.time_s - self._t0_source)
 
-    def _lost_tracking(self, t: float) -> bool:
+    def _lost_tracking(self, t: float) -> str | None:
         since = self._last_tracked_time if self._last_tracked_time is not None else self._t0_session
         if t - since > self.lost_tracking_timeout:
-            self.stop(f"{self.source.describe()}: no tracked joints for {t - since:.1f} s "
-                      f"(frame {self.stats.received}); is the performer in view?")
-            return True
-        return False
+            return (f"{self.source.describe()}: no tracked joints for {t - since:.1f} s "
+                    f"(frame {self.stats.received}); is the performer in view?")
+        return None
 
     def statistics(self) -> dict:
         return self.stats.as_dict(self.queue.overflowed)
