@@ -1,0 +1,116 @@
+"""Demo pieces with the real bpy wheel: the capsule body bound to a baked rig, and one Workbench still."""
+from __future__ import annotations
+
+import bpy
+import numpy as np
+import pytest
+
+from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
+from kinect_retarget.blender.body_mesh import add_body_mesh, body_bones
+from kinect_retarget.blender.render import stage_and_render
+from kinect_retarget.takes import kinect_v2_csv
+
+WAVE_FRAME = 60  # Ges01: the performer's right hand is up, waving, around here
+
+
+@pytest.fixture
+def baked_rig(shared_data):
+    """Generated Kinect rig with the first 70 frames of a real Kinect v2 take baked on it."""
+    take = kinect_v2_csv.read(shared_data / "kinect_v2" / "Ges01_wavehand.csv").slice(slice(0, 70))
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    obj = new_generated_rig(bpy.context.scene, take)
+    bake_take(obj, take, preset="kinect")
+    return obj
+
+
+def _rest_state(obj):
+    bones = obj.data.bones
+    return [b.name for b in bones], np.array([np.array(b.matrix_local) for b in bones])
+
+
+def _evaluated_vertices(obj) -> np.ndarray:
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    ob_eval = obj.evaluated_get(depsgraph)
+    mesh = ob_eval.to_mesh()
+    co = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    ob_eval.to_mesh_clear()
+    world = np.array(ob_eval.matrix_world)
+    return co.reshape(-1, 3) @ world[:3, :3].T + world[:3, 3]
+
+
+def test_body_mesh_is_bound_rigidly_and_follows_the_pose(baked_rig):
+    obj = baked_rig
+    names_before, rest_before = _rest_state(obj)
+    body = add_body_mesh(obj)
+
+    names_after, rest_after = _rest_state(obj)
+    assert names_after == names_before and np.allclose(rest_after, rest_before)  # armature untouched
+    assert body.parent == obj
+    mods = [m for m in body.modifiers if m.type == "ARMATURE"]
+    assert len(mods) == 1 and mods[0].object == obj and mods[0].use_vertex_groups
+    groups = [g.name for g in body.vertex_groups]
+    assert groups == body_bones(obj) and "HandRight" in groups and "KneeLeft" in groups
+    membership = np.array([[(g.group, g.weight) for g in v.groups] for v in body.data.vertices])
+    assert membership.shape == (len(body.data.vertices), 1, 2)      # one group per vertex
+    assert np.all(membership[:, 0, 1] == 1.0)                       # rigid weights
+
+    # posed: the right hand's capsule sits on the posed HandRight bone, not where it was at rest
+    bpy.context.scene.frame_set(WAVE_FRAME)
+    verts = _evaluated_vertices(body)
+    hand = groups.index("HandRight")
+    centre = verts[membership[:, 0, 0] == hand].mean(axis=0)
+    pb = obj.pose.bones["HandRight"]
+    world = np.array(obj.matrix_world)
+    mid = world[:3, :3] @ ((np.array(pb.head) + np.array(pb.tail)) / 2) + world[:3, 3]
+    rest_mid = world[:3, :3] @ np.array(obj.data.bones["HandRight"].head_local) + world[:3, 3]
+    assert np.linalg.norm(centre - mid) < 0.02
+    assert np.linalg.norm(mid - rest_mid) > 0.2  # the hand really moved: the check above means something
+
+
+def test_one_still_renders_with_the_right_hand_on_the_image_left(baked_rig, tmp_path):
+    body = add_body_mesh(baked_rig)
+    (path,) = stage_and_render(bpy.context.scene, [body], [WAVE_FRAME], str(tmp_path), "smoke",
+                               note="smoke", resolution=(160, 120))
+    assert path.endswith("smoke_f0060.png") and (tmp_path / "smoke_f0060.png").stat().st_size > 1000
+    image = bpy.data.images.load(path)
+    w, h = image.size
+    px = np.empty(w * h * 4, np.float32)
+    image.pixels.foreach_get(px)
+    rgb = px.reshape(h, w, 4)[..., :3]
+    assert (w, h) == (160, 120)
+    assert rgb.std(axis=(0, 1)).max() > 0.05                        # not a uniform image
+    red = (rgb[..., 0] > rgb[..., 1] + 0.2) & (rgb[..., 0] > rgb[..., 2] + 0.2)   # the character's right
+    blue = (rgb[..., 2] > rgb[..., 0] + 0.2)                                      # its left
+    assert red.sum() > 50 and blue.sum() > 50
+    # facing the camera at -Y, the character's right side is on the left of the picture
+    columns = np.arange(w)
+    assert (red * columns).sum() / red.sum() < (blue * columns).sum() / blue.sum()
+    # and the hand the performer waves (their right) is the raised one: the highest coloured pixel is red
+    rows = np.arange(h)[:, None]  # pixel rows come bottom row first from Blender
+    assert (rows * red).max() > (rows * blue).max()
+
+
+def test_body_bones_skip_face_and_fingers_on_the_human_metarig():
+    import addon_utils  # importable only once bpy is loaded
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    addon_utils.enable("rigify", default_set=True)  # after read_factory_settings, which disables add-ons
+    bpy.ops.object.armature_human_metarig_add()
+    metarig = bpy.context.view_layer.objects.active
+    names = body_bones(metarig)
+    for limb in ("upper_arm.L", "forearm.R", "thigh.L", "shin.R", "spine", "spine.006"):
+        assert limb in names
+    assert not [n for n in names if n.startswith(("f_", "thumb", "lip", "lid", "brow", "jaw", "ear", "nose"))]
+    body = add_body_mesh(metarig)
+    assert [g.name for g in body.vertex_groups] == names
+
+
+def test_add_body_mesh_rejects_what_it_cannot_bind(baked_rig):
+    mesh_obj = bpy.data.objects.new("NotARig", bpy.data.meshes.new("NotARig"))
+    with pytest.raises(ValueError, match="armature"):
+        add_body_mesh(mesh_obj)
+    with pytest.raises(ValueError, match="'Tail'"):
+        add_body_mesh(baked_rig, bones=["HandRight", "Tail"])
+    with pytest.raises(ValueError, match="no deform bone"):
+        add_body_mesh(baked_rig, bones=[])
