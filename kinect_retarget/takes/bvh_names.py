@@ -2,7 +2,7 @@
 
 Each Kinect joint lists alternatives, tried in order; an alternative is a tuple of BVH joint names whose
 positions are averaged (e.g. the head centre is halfway between the head joint and its end site). End sites
-are named `<parent>_end`. Names compare case-insensitively after dropping a namespace prefix ("mixamorig:").
+are named `<parent>_end`. Names compare case-insensitively after dropping a namespace prefix ("mixamorig:", "DEF-").
 
 Families are needed because the same name means different bones: "LeftShoulder" is the clavicle in CMU's
 MotionBuilder release (01_01) but the upper arm in its 3ds Max release (131_xx).
@@ -91,12 +91,60 @@ MIXAMO = _sided({  # Mixamo and other "Hips/Spine/LeftUpLeg" rigs (namespace pre
     "Foot{K}": [("{side}ToeBase",), ("{side}Foot_end",)],
 }, _LEFT, _RIGHT)
 
+BIPED = _sided({  # 3ds Max Character Studio Biped ("Bip01 L UpperArm"; "Bip001" is matched as "Bip01")
+    "HipCenter": [("Bip01 Pelvis",), ("Bip01",)],
+    "Spine": [("Bip01 Spine1",), ("Bip01 Spine",)],
+    "ShoulderCenter": [("Bip01 L UpperArm", "Bip01 R UpperArm")],
+    "Head": [("Bip01 Head", "Bip01 HeadNub"), ("Bip01 Head", "Bip01 Head_end"), ("Bip01 Head",)],
+    "Shoulder{K}": [("Bip01 {s} UpperArm",)],
+    "Elbow{K}": [("Bip01 {s} Forearm",)],
+    "Wrist{K}": [("Bip01 {s} Hand",)],
+    "Hand{K}": [("Bip01 {s} Finger2",), ("Bip01 {s} Finger1",), ("Bip01 {s} Finger0",), ("Bip01 {s} Hand_end",)],
+    "Hip{K}": [("Bip01 {s} Thigh",)],
+    "Knee{K}": [("Bip01 {s} Calf",)],
+    "Ankle{K}": [("Bip01 {s} Foot",)],
+    "Foot{K}": [("Bip01 {s} Toe0",), ("Bip01 {s} Foot_end",)],
+}, _LEFT, _RIGHT)
+
+DAZ = _sided({  # DAZ Studio / Poser figures ("lShldr", Genesis 3+ "lShldrBend")
+    "HipCenter": [("hip",)],
+    "Spine": [("abdomen", "chest"), ("abdomenUpper",), ("abdomen",)],
+    "ShoulderCenter": [("lShldr", "rShldr"), ("lShldrBend", "rShldrBend")],
+    "Head": [("head", "head_end"), ("head",)],
+    "Shoulder{K}": [("{S}Shldr",), ("{S}ShldrBend",)],
+    "Elbow{K}": [("{S}ForeArm",), ("{S}ForearmBend",)],
+    "Wrist{K}": [("{S}Hand",)],
+    "Hand{K}": [("{S}Mid1",), ("{S}Hand_end",)],
+    "Hip{K}": [("{S}Thigh",), ("{S}ThighBend",)],
+    "Knee{K}": [("{S}Shin",)],
+    "Ankle{K}": [("{S}Foot",)],
+    "Foot{K}": [("{S}Toe",), ("{S}Metatarsals",), ("{S}Foot_end",)],
+}, _LEFT, _RIGHT)
+
+RIGIFY = _sided({  # Blender's human metarig / Rigify deform bones ("upper_arm.L"; "DEF-" dropped)
+    "HipCenter": [("spine",), ("pelvis",), ("hips",)],
+    "Spine": [("spine.002",), ("spine.001",)],
+    "ShoulderCenter": [("upper_arm.L", "upper_arm.R")],
+    "Head": [("spine.006", "spine.006_end"), ("head", "head_end"), ("spine.006",), ("head",)],
+    "Shoulder{K}": [("upper_arm.{s}",)],
+    "Elbow{K}": [("forearm.{s}",)],
+    "Wrist{K}": [("hand.{s}",)],
+    "Hand{K}": [("f_middle.01.{s}",), ("hand.{s}_end",)],
+    "Hip{K}": [("thigh.{s}",)],
+    "Knee{K}": [("shin.{s}",)],
+    "Ankle{K}": [("foot.{s}",)],
+    "Foot{K}": [("toe.{s}",), ("foot.{s}_end",)],
+}, _LEFT, _RIGHT)
+
 # Tried in order; the first family that resolves every Kinect v1 joint wins.
 FAMILIES: dict[str, dict[str, list[tuple[str, ...]]]] = {
     "cmu_3dsmax": CMU_3DSMAX,
     "cmu_motionbuilder": CMU_MOTIONBUILDER,
     "makehuman": MAKEHUMAN,
     "mixamo": MIXAMO,
+    "biped": BIPED,
+    "daz": DAZ,
+    "rigify": RIGIFY,
 }
 
 # Metres per file unit for families whose unit is known (CMU: 1 unit = 1/0.45 inch; MakeHuman: decimetres).
@@ -104,8 +152,15 @@ FAMILY_UNITS = {"cmu_3dsmax": 0.0254 / 0.45, "cmu_motionbuilder": 0.0254 / 0.45,
 
 
 def canonical(name: str) -> str:
-    """Compare names case-insensitively and without a namespace prefix such as 'mixamorig:'."""
-    return name.rsplit(":", 1)[-1].strip().lower()
+    """Compare names case-insensitively, without a namespace ('mixamorig:') or Rigify layer ('DEF-')
+    prefix, with 3ds Max's 'Bip001' read as 'Bip01'."""
+    name = name.rsplit(":", 1)[-1].strip().lower()
+    for prefix in ("def-", "org-"):
+        if name.startswith(prefix):
+            name = name[len(prefix):]
+    if name.startswith("bip001"):
+        name = "bip01" + name[6:]
+    return name
 
 
 def resolve(bvh_names: list[str] | tuple[str, ...], kinect_joints: tuple[str, ...]

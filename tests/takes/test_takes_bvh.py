@@ -206,3 +206,43 @@ def test_empty_and_not_bvh(tmp_path):
         bvh.read(tmp_path / "text.bvh")
     with pytest.raises(TakeError, match="cannot read"):
         bvh.read(tmp_path / "missing.bvh")
+
+
+RENAMES = {  # CMU MotionBuilder name -> the same joint in other rig families (Left side; Right alike)
+    "biped": {"Hips": "Bip001 Pelvis", "Spine1": "Bip001 Spine1", "Head": "Bip001 Head",
+              "{L}Arm": "Bip001 {l} UpperArm", "{L}ForeArm": "Bip001 {l} Forearm", "{L}Hand": "Bip001 {l} Hand",
+              "{s}Fingers": "Bip001 {l} Finger2", "{L}UpLeg": "Bip001 {l} Thigh", "{L}Leg": "Bip001 {l} Calf",
+              "{L}Foot": "Bip001 {l} Foot", "{L}ToeBase": "Bip001 {l} Toe0"},
+    "daz": {"Hips": "hip", "LowerBack": "abdomen", "Spine1": "chest", "Head": "head", "{L}Arm": "{d}Shldr",
+            "{L}ForeArm": "{d}ForeArm", "{L}Hand": "{d}Hand", "{s}Fingers": "{d}Mid1", "{L}UpLeg": "{d}Thigh",
+            "{L}Leg": "{d}Shin", "{L}Foot": "{d}Foot", "{L}ToeBase": "{d}Toe"},
+    "rigify": {"Hips": "DEF-spine", "Spine1": "DEF-spine.002", "Head": "DEF-spine.006",
+               "{L}Arm": "DEF-upper_arm.{s}", "{L}ForeArm": "DEF-forearm.{s}", "{L}Hand": "DEF-hand.{s}",
+               "{s}Fingers": "DEF-f_middle.01.{s}", "{L}UpLeg": "DEF-thigh.{s}", "{L}Leg": "DEF-shin.{s}",
+               "{L}Foot": "DEF-foot.{s}", "{L}ToeBase": "DEF-toe.{s}"},
+    "mixamo": {n: f"mixamorig:{n}" for n in ("Hips", "Spine", "Spine1", "Head", "{L}Arm", "{L}ForeArm",
+                                            "{L}Hand", "{L}UpLeg", "{L}Leg", "{L}Foot", "{L}ToeBase")}
+    | {"{s}Fingers": "mixamorig:{L}HandMiddle1", "{L}FingerBase": "mixamorig:{L}HandRoot"},
+}
+SAME_DEFINITION = ("HipCenter", "ShoulderCenter", "ShoulderLeft", "ElbowLeft", "WristLeft", "HandLeft",
+                   "HipLeft", "KneeLeft", "AnkleLeft", "FootLeft", "ShoulderRight", "WristRight", "FootRight")
+
+
+@pytest.mark.parametrize("family", sorted(RENAMES))
+def test_other_rig_families_by_renaming_real_mocap(shared_data, tmp_path, family):
+    import re
+    table = {}
+    for src, dst in RENAMES[family].items():
+        for side, s, l, d in (("Left", "L", "L", "l"), ("Right", "R", "R", "r")):
+            table[src.format(L=side, s=s)] = dst.format(L=side, s=s, l=l, d=d)
+    text = (shared_data / "mocap_bvh" / "01_01.bvh").read_text()
+    text = re.sub(r"^(\s*(?:ROOT|JOINT) )(\S+)\s*$", lambda m: m.group(1) + table.get(m.group(2), m.group(2)),
+                  text, flags=re.M)
+    (tmp_path / "renamed.bvh").write_text(text)
+    motion = bvh.read_bvh_skeleton(tmp_path / "renamed.bvh")
+    assert motion.family == family
+    assert motion.units_to_metres == pytest.approx(CMU_UNIT)  # from the rest height: CMU units
+    take = bvh.read(tmp_path / "renamed.bvh")
+    ref = bvh.read(shared_data / "mocap_bvh" / "01_01.bvh")
+    idx = [KINECT_V1.index(j) for j in SAME_DEFINITION]
+    np.testing.assert_allclose(take.positions[:, idx], ref.positions[:, idx], atol=1e-9)
