@@ -7,6 +7,7 @@ exactly like a real host that fell behind.
 """
 from __future__ import annotations
 
+import math
 import threading
 from dataclasses import dataclass, field
 
@@ -91,6 +92,7 @@ class EmulatedIsoPump:
         self._handle = handle
         self.endpoint = endpoint
         self.window_s = transfers * packets_per_transfer * MICROFRAME_S   # what the host keeps armed
+        self.transfer_s = packets_per_transfer * MICROFRAME_S              # packets reach the host per transfer
         self._armed_until: float | None = None
         self._next = 0                 # next packet index of the current stream
         self._stream_id = None
@@ -135,7 +137,8 @@ class EmulatedIsoPump:
                 self._armed_until = now + self.window_s
                 if packets:
                     return packets
-                wake = stream.start_time + packet_due_time(self._next)
+                due = packet_due_time(self._next)
+                wake = stream.start_time + math.ceil(due / self.transfer_s) * self.transfer_s
             else:
                 self._armed_until = now + self.window_s
                 wake = deadline
@@ -146,7 +149,8 @@ class EmulatedIsoPump:
     def _collect(self, stream, now: float) -> list:
         out = []
         faults = self._device.faults
-        elapsed = now - stream.start_time
+        # like libusb, hand packets over a whole transfer at a time, when the transfer completes
+        elapsed = math.floor((now - stream.start_time) / self.transfer_s) * self.transfer_s
         armed = self._armed_until - stream.start_time
         while True:
             due = packet_due_time(self._next)
