@@ -42,6 +42,16 @@ def root_relative(p: np.ndarray, root: int = 0) -> np.ndarray:
     return p - p[:, root:root + 1]
 
 
+def sign_error_rate(pred: np.ndarray, truth: np.ndarray, parents: np.ndarray, bones: np.ndarray,
+                    min_depth_m: float = 0.05) -> float:
+    """Fraction of (frame, bone) samples, among bones clearly out of the image plane, whose depth order
+    (child nearer or farther than its parent) is wrong."""
+    dz_p = pred[:, bones, 2] - pred[:, parents[bones], 2]
+    dz_t = truth[:, bones, 2] - truth[:, parents[bones], 2]
+    clear = np.abs(dz_t) > min_depth_m
+    return float(np.mean(np.sign(dz_p[clear]) != np.sign(dz_t[clear]))) if clear.any() else 0.0
+
+
 def sign_flip_fraction(pred: np.ndarray, truth: np.ndarray, parents: np.ndarray, bones: np.ndarray,
                        min_depth_m: float = 0.05) -> float:
     """Fraction of frames where some bone's depth offset has the wrong sign (where it is clearly nonzero)."""
@@ -49,3 +59,16 @@ def sign_flip_fraction(pred: np.ndarray, truth: np.ndarray, parents: np.ndarray,
     dz_t = truth[:, bones, 2] - truth[:, parents[bones], 2]
     wrong = (np.sign(dz_p) != np.sign(dz_t)) & (np.abs(dz_t) > min_depth_m)
     return float(np.mean(wrong.any(axis=1)))
+
+
+def ray_sides(positions: np.ndarray, parents: np.ndarray, camera: Camera | None) -> np.ndarray:
+    """(F, J) the true depth signs in the lifter's sense: on which side of the point of its image ray
+    (orthographic line when camera is None) nearest to its parent each joint lies (+1 farther)."""
+    p = np.asarray(positions, dtype=np.float64)
+    par = p[:, np.maximum(parents, 0)]
+    if camera is None:
+        u = np.broadcast_to([0.0, 0.0, 1.0], p.shape)
+    else:
+        u = p / np.linalg.norm(p, axis=-1, keepdims=True)
+    along = np.sum((p - par) * u, axis=-1)
+    return np.where(along >= 0, 1.0, -1.0)

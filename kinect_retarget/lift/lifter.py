@@ -16,8 +16,9 @@ from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED, topologi
 from ..core.take import Take, nominal_rate
 from .bones import DEFAULT_HEIGHT_M, lengths_from_height
 from .camera import Camera
-from .depth import depth_magnitude, jitter_px
+from .depth import jitter_px
 from .gaps import fill_gaps
+from .geometry import JointLines
 from .scale import SCALE_BONES, fill_missing, smooth_lengths, scale_envelope, scale_lower_bound, scale_paper
 from .smoothing import gaussian_smooth
 from .signs import SignPriors, choose_signs
@@ -98,20 +99,16 @@ def lift(tracks: Tracks2D, settings: LiftSettings | None = None, *, scale: np.nd
 
     # Orthographic image coordinates in Kinect axes (pixels, relative to the principal point).
     xy = np.stack([-(uv[..., 0] - cam.cx), -(uv[..., 1] - cam.cy)], axis=-1)
-    bone_ok = have & have[:, np.maximum(PARENTS, 0)] & (PARENTS >= 0)
     d_vec = xy - xy[:, np.maximum(PARENTS, 0)]
     s = _scale(tracks, st, d_vec, measured, body, lengths) if scale is None else np.asarray(scale, float)
 
-    # Scaled orthographic depth magnitudes (paper §3.2, noise-aware) decide the signs ...
-    dxy = np.where(bone_ok[..., None], d_vec / s[:, None, None], 0.0)
-    c_obs = np.linalg.norm(dxy, axis=-1) / np.maximum(lengths, 1e-9)
-    dz = np.where(bone_ok, lengths * depth_magnitude(c_obs, np.sqrt(2.0) * sigma_px / (s[:, None] * np.maximum(lengths, 1e-9))), 0.0)
+    z_root = cam.focal_px / s
+    lines = JointLines.build(uv, cam, z_root, st.focal_px is not None, sigma_px)
+    root = lines.origin[:, SK.root] + lines.direction[:, SK.root] * (z_root / lines.direction[:, SK.root, 2])[:, None]
     if signs is None:
-        travel = _travel_direction(xy[:, SK.root] / s[:, None], cam.focal_px / s, tracks.times, body)
-        signs = choose_signs(dxy, dz, tracks.times, body, travel, st.priors, st.signs)
-    # ... and the joints are placed with the camera model.
-    positions = _place_joints(uv, have, body, s, signs, lengths, cam, st.focal_px is not None, sigma_px,
-                              tracks.times, st.smooth_depth_s)
+        travel = _travel_direction(root, tracks.times, body)
+        signs = choose_signs(lines, lengths, root, tracks.times, body, travel, st.priors, st.signs)
+    positions = _place_joints(lines, root, have, body, signs, lengths, tracks.times, st.smooth_depth_s)
     states = np.where(measured & ~filled, TRACKED, INFERRED).astype(np.uint8)
     states[~body] = NOT_TRACKED
     positions[~body] = np.nan
@@ -167,21 +164,16 @@ def _camera(tracks: Tracks2D, st: LiftSettings, problems: list[str]) -> Camera:
     return cam
 
 
-def _travel_direction(root_xy: np.ndarray, root_z: np.ndarray, times: np.ndarray, body: np.ndarray):
+def _travel_direction(root: np.ndarray, times: np.ndarray, body: np.ndarray):
     """(F, 3) horizontal direction of the body's travel, weighted 0..1 by speed (0 when standing)."""
     f = len(times)
     if f < 3:
         return np.zeros((f, 3))
-    p = np.stack([root_xy[:, 0], np.zeros(f), root_z], axis=-1)
-    p[~body] = np.nan
-    idx = np.arange(f)
-    for c in (0, 2):
-        ok = np.isfinite(p[:, c])
-        p[:, c] = np.interp(idx, idx[ok], p[ok, c]) if ok.any() else 0.0
-    w = max(1, int(round(0.5 / float(np.median(np.diff(times))))))
-    kern = np.ones(w) / w
-    sm = np.stack([np.convolve(np.pad(p[:, c], w, mode="edge"), kern, "same")[w:-w] for c in range(3)], -1)
-    v = np.gradient(sm, times, axis=0)
+    p = root.copy()
+    p[:, 1] = 0.0
+    p = gaussian_smooth(p, body[:, None], times, 0.25)
+    v = np.gradient(p, times, axis=0)
+    v[~body] = 0.0
     speed = np.linalg.norm(v, axis=-1, keepdims=True)
     return v / np.maximum(speed, 1e-9) * np.clip((speed - 0.2) / 0.5, 0.0, 1.0)
 
@@ -194,42 +186,22 @@ _DEFAULT_DIR.update({"Spine": _UP, "ShoulderCenter": _UP, "Head": _UP,
                      "HipLeft": np.array([-0.9, -0.45, 0]), "HipRight": np.array([0.9, -0.45, 0])})
 
 
-def _place_joints(uv, have, body, s, signs, lengths, cam: Camera, perspective: bool, sigma_px: float,
-                  times, smooth_s: float) -> np.ndarray:
-    """Walk the tree from the pelvis, putting each joint on its image ray (perspective) or orthographic
-    line at its bone's length from the parent, on the chosen depth side, so it reprojects onto its track.
-
-    With h the parent's distance from that line, the joint sits sqrt(L^2 - h^2) along it from the foot of
-    the perpendicular (the perspective form of dz = sqrt(L^2 - d^2/s^2)); with 2D noise we use the
-    noise-aware magnitude (depth.py) and smooth the signed offset over time. Joints never seen hang from
-    their parent in a default direction.
-    """
-    f = uv.shape[0]
+def _place_joints(lines: JointLines, root, have, body, signs, lengths, times, smooth_s: float) -> np.ndarray:
+    """Walk the tree from the pelvis, putting each joint on its line at its bone's length from the parent,
+    on the chosen side, so it reprojects onto its 2D track. The signed offset along the line is smoothed
+    over time (it is the noisy part). Joints never seen hang from their parent in a default direction."""
+    f = root.shape[0]
     pos = np.full((f, len(SK), 3), np.nan)
-    z_root = cam.focal_px / s
-    rays = cam.rays(np.nan_to_num(uv))
-    r = SK.root
-    pos[:, r] = rays[:, r] * z_root[:, None]
+    pos[:, SK.root] = root
     fwd = None
     for j in ORDER[1:]:
         parent = pos[:, PARENTS[j]]
-        if perspective:
-            o, d = np.zeros((f, 3)), rays[:, j]
-        else:  # orthographic: the line through the joint's (X, Y) at the root's depth, along the optical axis
-            o = np.concatenate([rays[:, j, :2] * z_root[:, None], np.zeros((f, 1))], axis=1)
-            d = np.tile([0.0, 0.0, 1.0], (f, 1))
-        dn = np.linalg.norm(d, axis=1)
-        u = d / dn[:, None]
-        foot = o + np.sum((parent - o) * u, axis=1)[:, None] * u  # nearest point of the line to the parent
-        c = np.linalg.norm(parent - foot, axis=1) / lengths[j]
-        depth_px = cam.focal_px / np.maximum(foot[:, 2], 1e-6)  # pixels per metre at the joint
-        mag = lengths[j] * depth_magnitude(c, np.sqrt(2.0) * sigma_px / (depth_px * lengths[j]))
-        along = gaussian_smooth(signs[:, j] * mag, have[:, j] & body, times, smooth_s)
-        on_line = foot + along[:, None] * u
+        foot, along, u = lines.offsets(j, parent, lengths[j])
+        along = gaussian_smooth(signs[:, j] * along, have[:, j] & body, times, smooth_s)
         if fwd is None and SK.joints[j].startswith("Foot"):
             fwd = _forward(pos)
         guessed = parent + lengths[j] * _default_direction(SK.joints[j], pos, PARENTS[j], fwd)
-        pos[:, j] = np.where(have[:, j, None], on_line, guessed)
+        pos[:, j] = np.where(have[:, j, None], foot + along[:, None] * u, guessed)
     return pos
 
 

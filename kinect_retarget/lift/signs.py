@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.skeletons import KINECT_V1, Skeleton
+from .geometry import JointLines
 from .viterbi import viterbi
 
 
@@ -54,7 +55,8 @@ class SignPriors:
     min_sigma_m: float = 0.015       # floor of that per-frame depth step (2D noise)
     jump_cost_cap: float = 4.0       # most a single joint's depth jump can cost in one frame
     knee_hyperextension: float = 40.0
-    elbow_hyperextension: float = 8.0
+    elbow_hyperextension: float = 15.0
+    elbow_tolerance: float = 0.05    # sine of the backward bend allowed before it costs
     hand_continues_forearm: float = 2.0
     foot_forward: float = 12.0
     wrist_behind_back: float = 4.0
@@ -69,21 +71,21 @@ def _sign_table(nbits: int) -> np.ndarray:
     return np.where((states[:, None] >> np.arange(nbits)) & 1, -1.0, 1.0)
 
 
-def group_positions(group: SignGroup, dxy: np.ndarray, dz: np.ndarray,
+def group_positions(group: SignGroup, lines: JointLines, anchor: np.ndarray, lengths: np.ndarray,
                     skeleton: Skeleton = KINECT_V1) -> np.ndarray:
-    """(F, S, n, 3) positions of the group's joints relative to its anchor for every sign pattern."""
+    """(F, T, S, n, 3) positions of the group's joints for every sign pattern S, given T hypotheses of
+    the anchor's position (F, T, 3)."""
     table = _sign_table(len(group.bits))
     names = group.joints
-    f = dxy.shape[0]
-    out = np.zeros((f, table.shape[0], len(names), 3))
+    f, t = anchor.shape[:2]
+    out = np.zeros((f, t, table.shape[0], len(names), 3))
+    base = np.broadcast_to(anchor[:, :, None, :], out.shape[:3] + (3,))
     for k, bit in enumerate(group.bits):
         for name, mult in bit:
             j = skeleton.index(name)
-            i = names.index(name)
             parent = skeleton.joints[skeleton.parents[j]]
-            base = out[:, :, names.index(parent)] if parent in names else 0.0
-            out[:, :, i, :2] = dxy[:, None, j] + (base[..., :2] if parent in names else 0.0)
-            out[:, :, i, 2] = mult * table[None, :, k] * dz[:, None, j] + (base[..., 2] if parent in names else 0.0)
+            p = out[:, :, :, names.index(parent)] if parent in names else base
+            out[:, :, :, names.index(name)] = lines.end(j, p, lengths[j], mult * table[None, None, :, k])
     return out
 
 
@@ -135,7 +137,7 @@ def _torso_unary(tp: np.ndarray, left: np.ndarray, fwd: np.ndarray, travel: np.n
 def _limb_unary(group: SignGroup, lp: np.ndarray, left: np.ndarray, fwd: np.ndarray,
                 pri: SignPriors) -> np.ndarray:
     """(F, St, Sl) cost of each limb pattern given each torso pattern's body frame."""
-    a, b, c = (lp[:, None, :, i] for i in range(3))  # joint positions rel. anchor: (F, 1, Sl, 3)
+    a, b, c = (lp[..., i, :] for i in range(3))  # joint positions rel. anchor: (F, St, Sl, 3)
     upper, lower, tip = a, b - a, c - b
     left, fwd = left[:, :, None], fwd[:, :, None]
     if group.name.startswith("leg"):
@@ -144,56 +146,63 @@ def _limb_unary(group: SignGroup, lp: np.ndarray, left: np.ndarray, fwd: np.ndar
         cost += pri.foot_forward * np.maximum(0.0, 0.2 - np.sum(_unit(tip) * fwd, axis=-1)) ** 2
     else:
         flex = _hinge(upper, lower, left)  # elbow flexion brings the forearm forward: negative about left
-        cost = pri.elbow_hyperextension * np.maximum(0.0, flex - 0.3) ** 2 * 10
+        cost = pri.elbow_hyperextension * np.maximum(0.0, flex - pri.elbow_tolerance) ** 2 * 10
         cost += pri.hand_continues_forearm * np.maximum(0.0, -np.sum(_unit(tip) * _unit(lower), axis=-1)) ** 2
         cost += pri.wrist_behind_back * np.maximum(0.0, -np.sum(b * fwd, axis=-1) - 0.3) ** 2 * 10
     return cost
 
 
-def choose_signs(dxy: np.ndarray, dz: np.ndarray, times: np.ndarray, valid: np.ndarray,
-                 travel: np.ndarray | None = None, priors: SignPriors = SignPriors(),
+def choose_signs(lines: JointLines, lengths: np.ndarray, root: np.ndarray, times: np.ndarray,
+                 valid: np.ndarray, travel: np.ndarray | None = None, priors: SignPriors = SignPriors(),
                  method: str = "viterbi", skeleton: Skeleton = KINECT_V1) -> np.ndarray:
-    """Depth sign (+1 away from the camera, -1 toward it) of every bone: (F, J), indexed by child joint.
+    """Side of every bone (+1: the joint is the farther of its two possible places along its line), (F, J)
+    indexed by child joint.
 
-    dxy (F, J, 2) in-plane bone offsets (metres, Kinect X/Y); dz (F, J) their depth magnitudes; valid (F,)
-    frames with a body; travel (F, 3) horizontal unit-ish direction the body moves (0 when still).
+    lines: each joint's image ray or orthographic line; root (F, 3) the pelvis position; valid (F,) frames
+    with a body; travel (F, 3) horizontal direction the body moves, weighted by speed (0 when still).
     method: "viterbi" (whole take), "greedy" (frame by frame, causal: usable live), "camera" (every bone
     toward the camera: no disambiguation, the baseline).
     """
-    f = dxy.shape[0]
+    f = root.shape[0]
     signs = np.ones((f, len(skeleton)))
     if method == "camera":
         return -signs
+    if method not in ("viterbi", "greedy"):
+        raise ValueError(f"unknown sign method {method!r} (viterbi, greedy, camera)")
     breaks = ~np.asarray(valid, dtype=bool)
     travel = np.zeros((f, 3)) if travel is None else travel
-    dxy = np.nan_to_num(dxy)
-    dz = np.nan_to_num(dz)
-    tp = group_positions(TORSO, dxy, dz, skeleton)
+    root = np.nan_to_num(root)
+    tp = group_positions(TORSO, lines, root[:, None], lengths, skeleton)[:, 0]  # (F, St, 7, 3)
     left, fwd = _torso_frame(tp)
-    limb_pos = [group_positions(g, dxy, dz, skeleton) for g in LIMBS]
-    limb_un = [_limb_unary(g, lp, left, fwd, priors) for g, lp in zip(LIMBS, limb_pos)]
-    unary = _torso_unary(tp, left, fwd, travel, priors) + sum(u.min(axis=2) for u in limb_un)
+    limb_pos, limb_un = [], []
+    for g in LIMBS:
+        anchor = tp[:, :, TORSO.joints.index(g.anchor)]                        # (F, St, 3)
+        lp = group_positions(g, lines, anchor, lengths, skeleton)               # (F, St, Sl, 3, 3)
+        limb_pos.append(lp - anchor[:, :, None, None, :])
+        limb_un.append(_limb_unary(g, limb_pos[-1], left, fwd, priors))        # (F, St, Sl)
+    unary = _torso_unary(tp - root[:, None, None, :], left, fwd, travel, priors)
+    unary = unary + sum(u.min(axis=2) for u in limb_un)
     unary[breaks] = 0.0
-    torso_state = _solve(unary, _temporal(tp[..., 2], times, priors, breaks), method)
+    rel_z = tp[..., 2] - root[:, None, None, 2]
+    torso_state = _solve(unary, _temporal(rel_z, times, priors, breaks), method)
     _write(signs, TORSO, torso_state, skeleton)
     rows = np.arange(f)
     for g, lp, lu in zip(LIMBS, limb_pos, limb_un):
         u = lu[rows, torso_state]
         u[breaks] = 0.0
-        _write(signs, g, _solve(u, _temporal(lp[..., 2], times, priors, breaks), method), skeleton)
+        z = lp[rows, torso_state][..., 2]
+        _write(signs, g, _solve(u, _temporal(z, times, priors, breaks), method), skeleton)
     return signs
 
 
 def _solve(unary: np.ndarray, pairwise: np.ndarray, method: str) -> np.ndarray:
     if method == "viterbi":
         return viterbi(unary, pairwise)
-    if method == "greedy":
-        out = np.empty(unary.shape[0], dtype=np.int64)
-        out[0] = int(np.argmin(unary[0]))
-        for t in range(1, unary.shape[0]):  # causal: each frame given the previous choice only
-            out[t] = int(np.argmin(unary[t] + pairwise[t - 1, out[t - 1]]))
-        return out
-    raise ValueError(f"unknown sign method {method!r} (viterbi, greedy, camera)")
+    out = np.empty(unary.shape[0], dtype=np.int64)
+    out[0] = int(np.argmin(unary[0]))
+    for t in range(1, unary.shape[0]):  # causal: each frame given the previous choice only
+        out[t] = int(np.argmin(unary[t] + pairwise[t - 1, out[t - 1]]))
+    return out
 
 
 def _write(signs: np.ndarray, group: SignGroup, states: np.ndarray, skeleton: Skeleton) -> None:
