@@ -98,6 +98,16 @@ class DepthStream:
     def running(self) -> bool:
         return self._thread is not None and self._thread.is_alive()
 
+    def latest_frame(self) -> DepthFrame | None:
+        """Empty the queue and return the newest frame (None if none arrived): for a live preview that
+        polls a few times per second from the main thread."""
+        frame = None
+        while True:
+            try:
+                frame = self.frames.get_nowait()
+            except queue.Empty:
+                return frame
+
     def start(self) -> "DepthStream":
         if self.running:
             return self

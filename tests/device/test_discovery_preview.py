@@ -51,3 +51,26 @@ def test_preview_of_a_real_frame(real_depth):
     near, far = np.unravel_index(np.argmin(np.where(small > 0, small, 1e9)), small.shape), \
         np.unravel_index(np.argmax(small), small.shape)
     assert img[near] > img[far] > 0
+
+
+def test_missing_libusb_is_a_clear_error(monkeypatch):
+    import builtins
+
+    import usb.backend.libusb1
+
+    from kinect_retarget.cli_device import main
+    from kinect_retarget.device.errors import LibusbMissing
+    from kinect_retarget.device.usb_backend import find_backend
+
+    real_import = builtins.__import__
+
+    def no_libusb_package(name, *args, **kwargs):
+        if name == "libusb_package":
+            raise ImportError(name)
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(usb.backend.libusb1, "get_backend", lambda *a, **k: None)
+    monkeypatch.setattr(builtins, "__import__", no_libusb_package)
+    with pytest.raises(LibusbMissing, match="libusb-1.0 could not be loaded"):
+        find_backend()
+    assert main(["devices"]) == 1

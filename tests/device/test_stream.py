@@ -115,6 +115,21 @@ def test_stop_ends_the_thread_and_releases_the_device(real_depth):
     assert all(queued for _, _, queued in emu.register_log[:-1])   # iso transfers queued before the start
 
 
+def test_latest_frame_for_a_live_preview(real_depth):
+    from kinect_retarget.device import depth_preview
+    emu = EmulatedKinect(real_depth[:3])
+    with DepthStream(emu, queue_size=4) as stream:
+        assert stream.latest_frame() is None or stream.status.frames > 0
+        deadline = time.monotonic() + 20
+        while stream.status.frames < 4 and time.monotonic() < deadline:   # let a few frames pile up
+            time.sleep(0.01)
+        newest = stream.latest_frame()
+        assert newest is not None and stream.frames.empty()
+        assert newest.index >= 3
+        assert depth_preview(newest.mm).shape == (120, 160)
+    assert not stream.running
+
+
 def test_waiting_for_a_device_that_is_not_there(real_depth):
     emu = EmulatedKinect(real_depth[:1])
     emu.unplug()
