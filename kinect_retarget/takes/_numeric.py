@@ -5,6 +5,7 @@ The fast path counts fields per line on the raw bytes (numpy, no Python loop) an
 """
 from __future__ import annotations
 
+import io
 import warnings
 
 import numpy as np
@@ -45,6 +46,9 @@ def parse_table(path: str, data: bytes, ncol: int | None, *, first_line: int = 1
     count, a non-numeric field or a NaN/infinite value.
     """
     text = normalise(data, delimiters)
+    fast = _fast_table(text, ncol)
+    if fast is not None:
+        return fast, np.arange(fast.shape[0]) + first_line
     counts = field_counts(text)
     rows = np.flatnonzero(counts)
     if rows.size == 0:
@@ -67,6 +71,21 @@ def parse_table(path: str, data: bytes, ncol: int | None, *, first_line: int = 1
         i = int(rows[np.argmax(~finite.all(axis=1))])
         raise TakeError(f"{path}:{i + first_line}: NaN or infinite value in {what}")
     return values, rows + first_line
+
+
+def _fast_table(text: bytes, ncol: int | None) -> np.ndarray | None:
+    """numpy's C text parser (about twice np.fromstring's speed) for the common case: no blank lines,
+    every line complete and numeric. Returns None whenever anything is off; the careful path then names it."""
+    body = text.rstrip()
+    if not body or b"\n\n" in body or _WS[body[0]]:
+        return None
+    try:
+        values = np.loadtxt(io.BytesIO(body), dtype=np.float64, comments=None, ndmin=2)
+    except ValueError:
+        return None
+    if (ncol is not None and values.shape[1] != ncol) or values.shape[0] != body.count(b"\n") + 1:
+        return None
+    return values if np.isfinite(values).all() else None
 
 
 def _raise_non_numeric(path: str, text: bytes, rows: np.ndarray, first_line: int, what: str) -> None:
