@@ -38,6 +38,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--calibration", metavar="DEPTH.npz",
                    help="with --replay: take the calibration from an earlier capture of the same Kinect")
     p.add_argument("--serial", help="which Kinect, when several are plugged in")
+    p.add_argument("--wait", type=float, default=10.0, metavar="S",
+                   help="give up if streaming has not started after S seconds (default 10)")
     p.set_defaults(handler=run_capture)
 
     p = sub.add_parser("tilt", help="tilt the Kinect (degrees from the horizon, -27..27)")
@@ -159,6 +161,7 @@ def _capture_live(args) -> int:
     raws, mms, stamps, lost = [], [], [], []
     calibration = Calibration()
     last_message, started = "", None
+    asked = time.monotonic()
     stream.start()
     try:
         while started is None or time.monotonic() - started < args.seconds:
@@ -168,7 +171,7 @@ def _capture_live(args) -> int:
                 last_message = status.message
             if started is None and status.state == STREAMING:
                 started = time.monotonic()
-            if started is None and status.state == "error":
+            if started is None and (status.state == "error" or time.monotonic() - asked > args.wait):
                 break
             try:
                 frame = stream.frames.get(timeout=0.05)
@@ -186,10 +189,12 @@ def _capture_live(args) -> int:
         if dump:
             dump.close()
     status = stream.status
+    if not raws:
+        return _fail(KinectError(f"no depth frame was captured ({last_message}); nothing written"))
     _save(args.out, raws, mms, stamps, lost, calibration)
     print(f"{len(raws)} frames -> {args.out} (dropped {status.frames_dropped}, "
           f"packets lost {status.packets_lost})" + (f"; packets -> {args.dump}" if dump else ""))
-    return 0 if raws else 1
+    return 0
 
 
 # --- motor ---------------------------------------------------------------------------------------------------

@@ -55,3 +55,19 @@ def test_errors_are_messages_not_tracebacks(tmp_path, capsys):
     bad.write_bytes(b"\xff\xff\xff\xff garbage")
     assert main(["capture", "--replay", str(bad), "--out", str(tmp_path / "y.npz")]) == 1
     assert "bad.dump" in capsys.readouterr().err
+
+
+def test_capture_gives_up_when_no_kinect_streams(tmp_path, capsys, monkeypatch):
+    from kinect_retarget import cli_device
+    from kinect_retarget.device.emulated import EmulatedKinect
+    from kinect_retarget.device.depth_images import synthetic_depth_frames
+
+    def unplugged_kinect(args):
+        emu = EmulatedKinect(synthetic_depth_frames(2))
+        emu.unplug()
+        return emu
+
+    monkeypatch.setattr(cli_device, "_backend", unplugged_kinect)
+    out = tmp_path / "none.npz"
+    assert main(["capture", "--simulate", "--seconds", "1", "--wait", "0.3", "--out", str(out)]) == 1
+    assert "no Kinect found" in capsys.readouterr().err and not out.exists()
