@@ -59,8 +59,8 @@ def test_errors_are_messages_not_tracebacks(tmp_path, capsys):
 
 def test_capture_gives_up_when_no_kinect_streams(tmp_path, capsys, monkeypatch):
     from kinect_retarget import cli_device
-    from kinect_retarget.device.emulated import EmulatedKinect
     from kinect_retarget.device.depth_images import synthetic_depth_frames
+    from kinect_retarget.device.emulated import EmulatedKinect
 
     def unplugged_kinect(args):
         emu = EmulatedKinect(synthetic_depth_frames(2))
