@@ -209,11 +209,15 @@ def _parse_motion_header(path: str, lines: list[str], motion_line: int) -> tuple
 # ------------------------------------------------------------------------------------ forward kinematics
 
 def axis_quaternions(angles_deg: np.ndarray, axes: np.ndarray) -> np.ndarray:
-    """(..., 4) quaternions (w, x, y, z) rotating by `angles_deg` (...) about coordinate axes `axes`
-    (broadcast against the angles; 0, 1, 2 = X, Y, Z)."""
+    """(..., N, 4) quaternions (w, x, y, z) rotating by `angles_deg` (..., N) about coordinate axes
+    `axes` (N,) or (..., N), values 0, 1, 2 = X, Y, Z."""
     half = np.radians(angles_deg) / 2
     q = np.zeros(half.shape + (4,))
     q[..., 0] = np.cos(half)
+    axes = np.asarray(axes)
+    if axes.ndim == 1 and half.ndim >= 1:  # one axis per joint: a single scatter, no per-axis masks
+        q[..., np.arange(axes.size), axes + 1] = np.sin(half)
+        return q
     axes = np.broadcast_to(axes, half.shape)
     sin = np.sin(half)
     for a in range(3):
@@ -227,10 +231,13 @@ def _axis_rotations(angles_deg: np.ndarray, axes: np.ndarray) -> np.ndarray:
 
 
 def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Rotate (F, 3) vectors by (F, 4) unit quaternions (cheaper than building matrices)."""
-    u, w = q[..., 1:], q[..., :1]
-    t = 2.0 * np.cross(u, v)
-    return v + w * t + np.cross(u, t)
+    """Rotate (..., 3) vectors by (..., 4) unit quaternions: v + 2w (u x v) + 2 u x (u x v)."""
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    vx, vy, vz = v[..., 0], v[..., 1], v[..., 2]
+    tx, ty, tz = 2 * (y * vz - z * vy), 2 * (z * vx - x * vz), 2 * (x * vy - y * vx)
+    return np.stack([vx + w * tx + (y * tz - z * ty),
+                     vy + w * ty + (z * tx - x * tz),
+                     vz + w * tz + (x * ty - y * tx)], axis=-1)
 
 
 def _local_transforms(sk: BvhSkeleton, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -263,18 +270,29 @@ def _local_transforms(sk: BvhSkeleton, values: np.ndarray) -> tuple[np.ndarray, 
     return rot, trans
 
 
+def _depth_levels(parents: np.ndarray) -> list[np.ndarray]:
+    """Joint indices grouped by depth below the root (parents come before children in file order)."""
+    depth = np.zeros(len(parents), dtype=np.int64)
+    for j, p in enumerate(parents):
+        depth[j] = depth[p] + 1 if p >= 0 else 0
+    return [np.flatnonzero(depth == d) for d in range(int(depth.max()) + 1)]
+
+
 def forward_kinematics(sk: BvhSkeleton, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Global positions (F, N, 3) and rotations (F, N, 4 quaternions) for every joint and frame."""
+    """Global positions (F, N, 3) and rotations (F, N, 4 quaternions) for every joint and frame.
+
+    Joints at the same depth are done together, so the Python loop runs once per level, not per joint.
+    """
     rot, trans = _local_transforms(sk, values)
     g_rot = np.empty_like(rot)
     g_pos = np.empty_like(trans)
-    for j, p in enumerate(sk.parents):  # parents precede children in file order
-        if p < 0:
-            g_rot[:, j] = rot[:, j]
-            g_pos[:, j] = trans[:, j]
-        else:
-            g_rot[:, j] = quat.mul(g_rot[:, p], rot[:, j])
-            g_pos[:, j] = g_pos[:, p] + _rotate(g_rot[:, p], trans[:, j])
+    levels = _depth_levels(sk.parents)
+    g_rot[:, levels[0]] = rot[:, levels[0]]
+    g_pos[:, levels[0]] = trans[:, levels[0]]
+    for joints in levels[1:]:
+        parents = sk.parents[joints]
+        g_rot[:, joints] = quat.mul(g_rot[:, parents], rot[:, joints])
+        g_pos[:, joints] = g_pos[:, parents] + _rotate(g_rot[:, parents], trans[:, joints])
     return g_pos, g_rot
 
 
