@@ -33,7 +33,7 @@ GENERATED_TAKES = ("kinect_v2_ges01_wavehand", "kinect_v2_ges04_comehere", "kine
                    "kinect_v2_kinectron_recorded_skeleton", "kinect_v1_cmu_131_03_hop",
                    "kinect_v1_cmu_01_01_jumps", "kinect_v1_cmu_131_01_walk")
 RIGIFY_TAKES = ("kinect_v2_ges01_wavehand", "kinect_v1_cmu_131_03_hop")
-RIGIFY_FRAMES = 100  # ~3 s of each take: Rigify bakes evaluate the rig frame by frame (slow)
+RIGIFY_FRAMES = 90  # 3 s of each take: Rigify bakes evaluate the rig frame by frame (slow)
 RIGS = {"kinect": "generated Kinect rig", "rigify": "Rigify rig (human metarig)"}
 
 
@@ -166,6 +166,7 @@ def make_rigify_rig(path: str) -> None:
         raise RuntimeError("Rigify did not generate a rig from the human metarig")
     metarig.hide_viewport = metarig.hide_render = True  # kept for re-generating, out of the pictures
     rig.name = "RigifyRig"
+    bpy.context.preferences.filepaths.save_version = 0
     bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False)
 
 
@@ -210,7 +211,9 @@ def run_job(job: Job, out: Path, args: argparse.Namespace, rigify_base: str | No
                 result.sheet = contact_sheet(result.stills, str(out / "renders" / f"{stem}_sheet.png"))
         result.render_s = time.perf_counter() - t1
     scene.frame_set(baked.frame_range[0])
+    scene.render.filepath = f"//renders/{stem}_anim_"  # Render Animation in the saved file writes beside it
     result.blend = str(out / f"{stem}.blend")
+    bpy.context.preferences.filepaths.save_version = 0  # re-running the demo leaves no .blend1 backups
     with quiet_stdout():
         bpy.ops.wm.save_as_mainfile(filepath=result.blend, check_existing=False)
     return result
@@ -269,6 +272,9 @@ def main(argv: list[str] | None = None) -> int:
         except (TakeError, ValueError, OSError, RuntimeError) as exc:
             outcome = Outcome(job, error=str(exc))
             log(f"  failed: {exc}")
+        except Exception as exc:  # unexpected: say what, keep the other bakes going
+            outcome = Outcome(job, error=f"{type(exc).__name__}: {exc}")
+            log(f"  failed unexpectedly: {outcome.error}")
         else:
             log(f"  {outcome.frames} frames, {outcome.bones} bones ({outcome.preset}) in {outcome.bake_s:.2f} s; "
                 f"{len(outcome.stills)} stills in {outcome.render_s:.2f} s")
