@@ -136,10 +136,10 @@ def test_no_tracked_frame(shared_data, tmp_path):
 
 def test_corrupted_kinectron(shared_data, tmp_path):
     text = (shared_data / "kinect_v2" / "recorded_skeleton.json").read_text()
-    raw = json.loads(text)
     (tmp_path / "cut.json").write_text(text[: len(text) // 2])
     with pytest.raises(TakeError, match=r"cut\.json:1: invalid JSON at column \d+"):
         load_take(tmp_path / "cut.json")
+    head = json.dumps(json.loads(text)[:30])  # the cases below only need the first records
     cases = {
         "joints.json": (lambda r: r[7].__setitem__("joints", r[7]["joints"][:24]),
                         r"joints\.json: record 7: expected 25 joints, found 24"),
@@ -151,15 +151,14 @@ def test_corrupted_kinectron(shared_data, tmp_path):
         "time.json": (lambda r: r[20].__setitem__("record_timestamp", r[10]["record_timestamp"]),
                       r"time\.json: record 20: record_timestamp"),
         "none.json": (lambda r: [f.__setitem__("tracked", False) for f in r],
-                      r"none\.json: no tracked body in any of its 286 records"),
+                      r"none\.json: no tracked body in any of its 30 records"),
     }
     for name, (edit, pattern) in cases.items():
-        doc = json.loads(text)
+        doc = json.loads(head)
         edit(doc)
         (tmp_path / name).write_text(json.dumps(doc))
         with pytest.raises(TakeError, match=pattern):
             load_take(tmp_path / name)
-    assert len(raw) == 286
 
 
 def test_readers_registered():

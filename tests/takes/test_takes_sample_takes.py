@@ -79,7 +79,9 @@ def test_round_trip_through_krtake(tmp_path):
         _same(krtake.read(again), take, atol=0)
 
 
-def test_tool_is_deterministic(tool, shared_data, tmp_path):
-    tool.build(shared_data, tmp_path)
-    for path in sorted(SAMPLES.glob("*.krtake")):
-        assert (tmp_path / path.name).read_bytes() == path.read_bytes(), f"{path.name} is stale"
+def test_tool_output_is_what_is_committed(sources, tmp_path):
+    """The tool's takes, converted again now, write exactly the committed bytes (nothing stale)."""
+    for name, take in sources.items():
+        krtake.write(tmp_path / f"{name}.krtake", take)
+        assert (tmp_path / f"{name}.krtake").read_bytes() == (SAMPLES / f"{name}.krtake").read_bytes(), \
+            f"sample_takes/{name}.krtake is stale: run tools/make_sample_takes.py"
