@@ -55,10 +55,12 @@ class SignPriors:
     min_sigma_m: float = 0.015       # floor of that per-frame depth step (2D noise)
     jump_cost_cap: float = 4.0       # most a single joint's depth jump can cost in one frame
     knee_hyperextension: float = 40.0
+    knee_tolerance: float = 0.0      # sine of the forward knee bend allowed before it costs
     elbow_hyperextension: float = 15.0
     elbow_tolerance: float = 0.05    # sine of the backward bend allowed before it costs
     hand_continues_forearm: float = 2.0
     foot_forward: float = 12.0
+    foot_tolerance: float = 0.2      # how far forward (cosine) a foot should point before it is free
     wrist_behind_back: float = 4.0
     shoulder_hip_twist: float = 6.0
     trunk_lean_back: float = 6.0
@@ -142,8 +144,8 @@ def _limb_unary(group: SignGroup, lp: np.ndarray, left: np.ndarray, fwd: np.ndar
     left, fwd = left[:, :, None], fwd[:, :, None]
     if group.name.startswith("leg"):
         flex = _hinge(upper, lower, left)  # knee flexion bends the shin back: positive about the left axis
-        cost = pri.knee_hyperextension * np.maximum(0.0, -flex - 0.05) ** 2 * 10
-        cost += pri.foot_forward * np.maximum(0.0, 0.2 - np.sum(_unit(tip) * fwd, axis=-1)) ** 2
+        cost = pri.knee_hyperextension * np.maximum(0.0, -flex - pri.knee_tolerance) ** 2 * 10
+        cost += pri.foot_forward * np.maximum(0.0, pri.foot_tolerance - np.sum(_unit(tip) * fwd, axis=-1)) ** 2
     else:
         flex = _hinge(upper, lower, left)  # elbow flexion brings the forearm forward: negative about left
         cost = pri.elbow_hyperextension * np.maximum(0.0, flex - pri.elbow_tolerance) ** 2 * 10
