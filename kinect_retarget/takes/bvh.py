@@ -328,15 +328,8 @@ def read_bvh_skeleton(path: str | os.PathLike, scale: float | None = None) -> Bv
     return motion
 
 
-def read(path: str | os.PathLike, scale: float | None = None,
-         camera_distance: float = DEFAULT_CAMERA_DISTANCE, camera_height: float = DEFAULT_CAMERA_HEIGHT,
-         min_range: float | None = MIN_RANGE) -> Take:
-    """A BVH file as a Kinect v1 take seen by a virtual sensor in front of the performer.
-
-    If the performer walks or jumps toward the sensor closer than `min_range` metres, the sensor is moved
-    back (along the line it looks down) until they never do; None keeps it exactly at `camera_distance`.
-    """
-    motion = read_bvh_skeleton(path, scale)
+def kinect_joints_lab(motion: BvhMotion) -> np.ndarray:
+    """(F, 20, 3) Kinect v1 joints in lab axes and metres, from the name tables (bvh_names.py)."""
     family, mapping = _family(motion.skeleton)
     if family is None:
         detail = "; ".join(f"{fam}: no {', '.join(miss[:4])}{'...' if len(miss) > 4 else ''}"
@@ -344,53 +337,78 @@ def read(path: str | os.PathLike, scale: float | None = None,
         raise TakeError(f"{motion.path}: BVH skeleton not recognised as a humanoid (tried {detail}). "
                         f"Its joints: {', '.join(motion.skeleton.names[:12])}...")
     pos = np.stack([motion.positions[:, list(idx)].mean(axis=1) for idx in mapping.values()], axis=1)
-    pos_m = pos * motion.units_to_metres
-    all_m = motion.positions_m
-    camera = camera_frame(motion, pos_m, all_m, camera_distance, camera_height)
-    kinect = np.einsum("ab,fjb->fja", camera["rotation"], pos_m - camera["position"])
-    pushed = 0.0
-    if min_range is not None and kinect[..., 2].min() < min_range:
-        pushed = float(min_range - kinect[..., 2].min())
-        kinect[..., 2] += pushed
-        camera["position"] = camera["position"] - camera["rotation"][2] * pushed
-    states = np.full(kinect.shape[:2], TRACKED, dtype=np.uint8)
-    times = np.arange(motion.frame_count) * motion.frame_time
-    rate = _round_rate(1.0 / motion.frame_time)
-    meta = {"source_file": os.path.basename(motion.path), "bvh_family": family,
-            "bvh_units_to_metres": motion.units_to_metres,
-            "virtual_camera": {"distance_m": camera_distance + pushed, "height_m": camera_height,
-                               "position_lab_m": camera["position"].round(4).tolist(),
-                               "rotation_lab_to_kinect": camera["rotation"].round(6).tolist()},
-            "converted": "optical mocap (BVH) sampled at the Kinect v1 joints by kinect_retarget"}
-    try:
-        return Take(KINECT_V1, kinect, states, times, rate, "bvh", meta)
-    except TakeError as exc:
-        raise TakeError(f"{motion.path}: {exc}") from None
+    return pos * motion.units_to_metres
 
 
-def camera_frame(motion: BvhMotion, kinect_lab_m: np.ndarray, all_lab_m: np.ndarray,
-                 distance: float, height: float) -> dict:
-    """The virtual Kinect: position (lab metres) and the rotation taking lab vectors to camera space.
+@dataclass
+class VirtualKinect:
+    """A level sensor looking at the performer. `rotation` rows are the Kinect X, Y, Z axes in lab
+    coordinates; `position` is in lab metres; `floor` is the lab height (metres, along up) of the floor."""
 
-    kinect_lab_m: (F, 20, 3) Kinect v1 joints in lab metres; all_lab_m: (F, N, 3) every BVH joint.
+    position: np.ndarray
+    rotation: np.ndarray
+    floor: float
+    distance: float
+    height: float
+
+    def to_kinect(self, points_lab_m: np.ndarray) -> np.ndarray:
+        """(..., 3) lab points in metres -> Kinect camera space."""
+        return (np.asarray(points_lab_m) - self.position) @ self.rotation.T
+
+    def as_dict(self) -> dict:
+        return {"distance_m": self.distance, "height_m": self.height, "floor_lab_m": round(self.floor, 5),
+                "position_lab_m": self.position.round(4).tolist(),
+                "rotation_lab_to_kinect": self.rotation.round(6).tolist()}
+
+
+def virtual_kinect(motion: BvhMotion, distance: float = DEFAULT_CAMERA_DISTANCE,
+                   height: float = DEFAULT_CAMERA_HEIGHT, min_range: float | None = MIN_RANGE) -> VirtualKinect:
+    """Where the virtual sensor stands for this motion (docs/take_formats.md, BVH step 5).
+
+    `distance` metres in front of the hips at frame 0 (facing = (left hip - right hip) x up), `height` metres
+    above the floor (the lowest any joint goes), level. If the performer ever comes closer than `min_range`
+    metres, the sensor backs away along its viewing axis until they never do (None: stay put).
     """
+    joints = kinect_joints_lab(motion)
     up = np.zeros(3)
     up[motion.up_axis] = motion.up_sign
-    floor = float(np.min(all_lab_m @ up))                    # lowest any joint ever goes
+    floor = float(np.min(motion.positions_m @ up))
     k = KINECT_V1.index
-    left = kinect_lab_m[0, k("HipLeft")] - kinect_lab_m[0, k("HipRight")]
+    left = joints[0, k("HipLeft")] - joints[0, k("HipRight")]
     left -= up * (left @ up)
     if np.linalg.norm(left) < 1e-9:
         raise TakeError(f"{motion.path}: hips coincide at frame 0; cannot tell which way the performer faces")
     forward = np.cross(left, up)
     forward /= np.linalg.norm(forward)
-    start = kinect_lab_m[0, k("HipCenter")]
+    start = joints[0, k("HipCenter")]
     start = start - up * (start @ up) + up * floor           # on the floor under the hips at frame 0
-    position = start + forward * distance + up * height
     z_axis = -forward                                        # the sensor looks back at the performer
-    x_axis = np.cross(up, z_axis)                            # the sensor's left
-    rotation = np.stack([x_axis, up, z_axis])                # rows: Kinect axes in lab coordinates
-    return {"position": position, "rotation": rotation, "floor": floor}
+    rotation = np.stack([np.cross(up, z_axis), up, z_axis])  # X is the sensor's left
+    cam = VirtualKinect(start + forward * distance + up * height, rotation, floor, distance, height)
+    if min_range is not None:
+        nearest = float(cam.to_kinect(joints)[..., 2].min())
+        if nearest < min_range:
+            cam.distance += min_range - nearest
+            cam.position = cam.position - z_axis * (min_range - nearest)
+    return cam
+
+
+def read(path: str | os.PathLike, scale: float | None = None,
+         camera_distance: float = DEFAULT_CAMERA_DISTANCE, camera_height: float = DEFAULT_CAMERA_HEIGHT,
+         min_range: float | None = MIN_RANGE) -> Take:
+    """A BVH file as a Kinect v1 take seen by a virtual sensor in front of the performer (virtual_kinect)."""
+    motion = read_bvh_skeleton(path, scale)
+    cam = virtual_kinect(motion, camera_distance, camera_height, min_range)
+    kinect = cam.to_kinect(kinect_joints_lab(motion))
+    states = np.full(kinect.shape[:2], TRACKED, dtype=np.uint8)
+    times = np.arange(motion.frame_count) * motion.frame_time
+    meta = {"source_file": os.path.basename(motion.path), "bvh_family": motion.family,
+            "bvh_units_to_metres": motion.units_to_metres, "virtual_camera": cam.as_dict(),
+            "converted": "optical mocap (BVH) sampled at the Kinect v1 joints by kinect_retarget"}
+    try:
+        return Take(KINECT_V1, kinect, states, times, _round_rate(1.0 / motion.frame_time), "bvh", meta)
+    except TakeError as exc:
+        raise TakeError(f"{motion.path}: {exc}") from None
 
 
 def _round_rate(rate: float) -> float:

@@ -251,3 +251,15 @@ def test_other_rig_families_by_renaming_real_mocap(shared_data, tmp_path, family
     ref = bvh.read(tmp_path / "original.bvh", min_range=None)
     idx = [KINECT_V1.index(j) for j in SAME_DEFINITION]
     np.testing.assert_allclose(take.positions[:, idx], ref.positions[:, idx], atol=1e-9)
+
+
+def test_virtual_kinect_reproduces_the_take(jump, shared_data):
+    """Other code projects any BVH joint with the same sensor as the take (e.g. fingertips to 2D)."""
+    take = bvh.read(shared_data / "mocap_bvh" / "01_01.bvh")
+    cam = bvh.virtual_kinect(jump)
+    np.testing.assert_allclose(cam.to_kinect(bvh.kinect_joints_lab(jump)), take.positions, atol=1e-12)
+    assert cam.as_dict()["distance_m"] == pytest.approx(take.metadata["virtual_camera"]["distance_m"])
+    everything = cam.to_kinect(jump.positions_m)
+    assert everything[..., 2].min() > 0.9  # every BVH joint, end sites included, stays in front
+    np.testing.assert_allclose(cam.rotation @ cam.rotation.T, np.eye(3), atol=1e-12)
+    assert np.linalg.det(cam.rotation) == pytest.approx(1.0)  # a rotation: nothing mirrored
