@@ -22,6 +22,18 @@ class Score:
     nan_frames: int
 
 
+def facing_angle(gt: np.ndarray) -> np.ndarray:
+    """(F,) degrees between the performer's facing (from the ground-truth hips and shoulders) and the
+    direction toward the sensor: 0 = facing it, 90 = side on, 180 = back to it."""
+    j = KINECT_V1.index
+    lat = (gt[:, j("HipLeft")] - gt[:, j("HipRight")]) + (gt[:, j("ShoulderLeft")] - gt[:, j("ShoulderRight")])
+    facing = np.cross(lat, [0.0, 1.0, 0.0])   # left x up = forward, in Kinect camera space
+    toward = -gt[:, j("HipCenter")]
+    facing[:, 1] = toward[:, 1] = 0
+    c = np.sum(facing * toward, -1) / np.maximum(np.linalg.norm(facing, axis=-1) * np.linalg.norm(toward, axis=-1), 1e-9)
+    return np.degrees(np.arccos(np.clip(c, -1, 1)))
+
+
 def score(positions: np.ndarray, states: np.ndarray, gt: np.ndarray, present: np.ndarray) -> Score:
     has = np.any(states != NOT_TRACKED, axis=1) & present
     nan_frames = int(np.sum(~np.all(np.isfinite(positions), axis=(1, 2))))

@@ -100,7 +100,7 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     mask = mask_full[r0:r1:k, c0:c1:k]
     cell = float(np.median(xyz[mask][:, 2])) * grid.step * k / grid.camera.f   # metres per cell
     band = lambda w: max(w, 1.5 * cell)
-    graph = SurfaceGraph(xyz, mask)
+    graph = SurfaceGraph(xyz, mask, max_jump=0.06)
     proj = Projector(grid, (r0, c0, k), xyz, mask)
     H = calib.height
     # --- torso ---------------------------------------------------------------------------------------
@@ -109,6 +109,14 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     if seed is None:
         return None
     d0 = graph.distances(np.array([seed]))
+    cut_off = mask & ~np.isfinite(d0)
+    if cut_off.sum() > 10:
+        # parts joined to the body only across depth steps (a limb seen edge-on at the hip or shoulder):
+        # reach them through a permissive graph so their extremities still count, with the steps' length
+        loose = SurfaceGraph(xyz, mask, max_jump=0.25)
+        d0 = loose.distances(np.array([seed]), init=d0)
+    else:
+        loose = graph
     patch = xyz[d0 < 0.1 * H]
     if len(patch) < 10:
         return None
@@ -129,7 +137,7 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
         lat = _unit(lat - (lat @ axis) * axis)
     inside = lambda name: view * bm.DEPTH_INSIDE[name]
     # --- extremities ---------------------------------------------------------------------------------
-    extrema = (geodesic_extrema(graph, d0, count=6, min_distance=0.15 * H, iterations=4) if EXTREMA == "plagemann"
+    extrema = (geodesic_extrema(loose, d0, count=7, min_distance=0.15 * H, iterations=4) if EXTREMA == "plagemann"
                else geodesic_maxima(xyz, d0, count=6, min_distance=0.15 * H, window=max(3, int(0.12 / cell) | 1)))
     cand = []
     for r, c, dist in extrema:
@@ -140,7 +148,11 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     # the head top pins the torso along its axis (the torso patch alone drifts along the body)
     if head is not None:
         anchored = head[1] - axis * (1.0 - calib.torso_patch_height) * H
-        centre = centre + axis * ((anchored - centre) @ axis)
+        shift = (anchored - centre) @ axis
+        if abs(shift) > 0.15:  # not the head (a shoulder or raised hand): the torso cannot move that far
+            head = None
+        else:
+            centre = centre + axis * shift
     def along(h_frac: float) -> np.ndarray:
         return centre + axis * (h_frac - calib.torso_patch_height) * H
 
@@ -152,7 +164,8 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
         st[J[name]] = TRACKED
     rest = [e for e in cand if e is not head]
     feet = sorted([e for e in rest if e[3] < -0.33 * H], key=lambda e: -e[2])[:2]
-    hands = sorted([e for e in rest if e not in feet and e[3] > -0.35 * H], key=lambda e: -e[2])[:2]
+    hands = sorted([e for e in rest if e not in feet and e[3] > -0.35 * H and e[2] > 0.22 * H],
+                   key=lambda e: -e[2])[:2]
     labels = []
     if head is not None:
         dh = graph.distances(np.array([head[0]]), iterations=3)
@@ -174,6 +187,9 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
         assign = _assign_sides(found, prev, prev_states, tip, lat, centre)
         for s in SIDES:
             e = assign.get(s)
+            if (e is not None and prev is not None and prev_states is not None
+                    and prev_states[J[f"{tip}{s}"]] == TRACKED and np.linalg.norm(e[1] - prev[J[f"{tip}{s}"]]) > 0.45):
+                e = None  # a hand or foot does not jump 45 cm in one frame: another body part's extremity
             a = pos[J[f"{root}{s}"]]
             l1, l2 = r1 * H, r2 * H
             if e is not None:
@@ -186,7 +202,15 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
                 labels.append((f"{tip}{s}", e[1]))
                 st_limb = TRACKED
             else:
-                end_p, tip_p, mid_ls = _carry(prev, s, end, tip, a, axis, pos, root)
+                found_arm = _hanging_arm(xyz, mask, a, axis, lat, 1.0 if s == "Left" else -1.0, centre, H) \
+                    if root == "Shoulder" else None
+                if found_arm is not None:
+                    toward = _unit(a - found_arm)
+                    tip_p = found_arm + toward * 0.07 + inside(tip)
+                    end_p = tip_p + toward * bm.HAND * H
+                    mid_ls = None
+                else:
+                    end_p, tip_p, mid_ls = _carry(prev, s, end, tip, a, axis, pos, root)
                 st_limb = INFERRED
             cands, end_p2 = two_bone_candidates(a, end_p, l1, l2)
             cost = proj.cost(cands, bm.DEPTH_INSIDE[mid])
@@ -206,6 +230,22 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
             st[J[f"{mid}{s}"]] = TRACKED if mid_ok or st_limb == TRACKED else INFERRED
             st[J[f"{end}{s}"]] = st[J[f"{tip}{s}"]] = st_limb
     return FitResult(pos, st, lat, labels, centre, None if head is None else head[1])
+
+
+def _hanging_arm(xyz, mask, shoulder, axis, lat, sign, centre, H):
+    """Hand of an arm hanging beside the body (touching it, so no geodesic extremity): the point on that
+    side, outside the torso's width and within reach, farthest below the shoulder."""
+    pts = xyz[mask]
+    rel = pts - centre
+    side = (rel @ lat) * sign
+    below = (shoulder - pts) @ axis
+    reach = np.linalg.norm(pts - shoulder, axis=1)
+    ok = (side > 0.1 * H) & (below > 0.1 * H) & (reach < (bm.UPPER_ARM + bm.FOREARM + bm.HAND) * H + 0.05)
+    if ok.sum() < 5:
+        return None
+    far = np.argsort(-below[ok])[:5]   # a few lowest points: the finger tips
+    tip = pts[ok][far].mean(axis=0)
+    return tip - axis * 0.0
 
 
 def _carry(prev, s, end, tip, root_pos, axis, pos, root):
