@@ -25,8 +25,8 @@ def registered(bpy_empty):
 @pytest.fixture(scope="session")
 def rigify_rig_path(tmp_path_factory):
     """A Rigify rig generated headless from Blender's human metarig, saved once per session."""
+    import bpy  # noqa: I001 (addon_utils is importable only after bpy)
     import addon_utils
-    import bpy
     bpy.ops.wm.read_factory_settings(use_empty=True)
     addon_utils.enable("rigify", default_set=True)  # after the factory reset, which would disable it
     bpy.ops.object.armature_human_metarig_add()
