@@ -13,11 +13,13 @@ import time
 from dataclasses import replace
 
 import bpy
+import numpy as np
 from bpy.app.handlers import persistent
 
 from ..core.pipeline import RetargetPipeline, RetargetSettings
 from ..core.presets import RIGIFY_FK_SWITCHES, build_mapping
 from ..core.take import TakeError
+from ..live.constrained import ConstrainedParentCorrection
 from ..live.calibration import PROPERTY as CALIBRATION_PROPERTY, Calibration, CalibrationError
 from ..live.session import LiveSession
 from ..sources import OscReceiver, SourceError, TakePlayback, UsbKinectSource
@@ -49,6 +51,13 @@ class LiveController:
         self.started_at = time.perf_counter()
         self._saved = _save_state(obj)
         self._rigify_fk(obj)
+        pipeline = session.pipeline
+        corrector = ConstrainedParentCorrection(pipeline.rig, pipeline.bone_names, _constrained_bones(obj)) \
+            if hasattr(pipeline, "rig") else None
+        self.corrector = corrector if corrector is not None and corrector.active else None
+        self.update_after_apply = bool(bpy.app.background)
+        if self.corrector is not None:
+            self._read = [(b, pipeline.rig.bone_names[b]) for b in self.corrector.read]
 
     # -- helpers -------------------------------------------------------------------------------------------
     def obj(self):
@@ -76,7 +85,19 @@ class LiveController:
         obj = self.obj()
         if obj is None:
             raise RuntimeError(f"armature {self.obj_name!r} no longer exists")
+        if self.corrector is not None:
+            pose.quats = self.corrector.correct(pose.quats, self._evaluated(obj), getattr(pose, "desired", None))
         apply_frame_pose(obj, pose)
+        if self.corrector is not None and self.update_after_apply:
+            bpy.context.view_layer.update()  # no viewport redraw to evaluate the constrained parents
+
+    def _evaluated(self, obj) -> dict:
+        """Armature-space rotations of the constrained parents, as Blender last evaluated them."""
+        out = {}
+        for b, name in self._read:
+            m = np.array(obj.pose.bones[name].matrix, dtype=np.float64)[:3, :3]
+            out[b] = m / np.linalg.norm(m, axis=0, keepdims=True)  # drop pose scale
+        return out
 
     # -- pumping ---------------------------------------------------------------------------------------------
     def pump(self) -> bool:
@@ -193,6 +214,15 @@ class LiveController:
         if bpy.app.timers.is_registered(_timer):
             bpy.app.timers.unregister(_timer)
         _redraw()
+
+
+def _constrained_bones(obj) -> set[str]:
+    """Bones whose pose Blender computes from more than their parent: constraints or drivers."""
+    names = {pb.name for pb in obj.pose.bones if len(pb.constraints)}
+    ad = obj.animation_data
+    if ad is not None:
+        names.update(d.data_path.split('"')[1] for d in ad.drivers if d.data_path.startswith('pose.bones["'))
+    return names
 
 
 def _save_state(obj) -> dict:

@@ -34,5 +34,8 @@ def process_batch(pipeline, positions: np.ndarray, states: np.ndarray, times: np
     filtered = pipeline._filtered(pos, st, tt)
     if pipeline.root_reference is None:
         pipeline.root_reference = filtered[0, pipeline.skeleton.root].copy()
-    quats, location = pipeline.retargeter.solve(filtered[-1:], pipeline.root_reference, pipeline.source_leg)
-    return FramePose(pipeline.bone_names, quats[0], pipeline.root_bone, location[0], float(tt[-1]))
+    quats, location, desired = pipeline.retargeter.solve(filtered[-1:], pipeline.root_reference,
+                                                         pipeline.source_leg, want_desired=True)
+    pose = FramePose(pipeline.bone_names, quats[0], pipeline.root_bone, location[0], float(tt[-1]))
+    pose.desired = desired[0]  # for rigs with constrained parents (live/constrained.py)
+    return pose
