@@ -63,3 +63,26 @@ def test_errors(shared_data, tmp_path):
     shutil.copy(folder / "m07_s01_e01_positions.txt", tmp_path / "renamed.txt")
     with pytest.raises(TakeError, match=r"renamed\.txt: UI-PRMD files are named"):
         load_take(tmp_path / "renamed.txt")
+
+
+@pytest.mark.parametrize("how, pattern", [
+    ("truncated", r"positions\.txt:13: expected 66 values, found \d+"),
+    ("nan", r"positions\.txt:13: NaN or infinite value"),
+    ("garbage", r"positions\.txt:13: non-numeric value 'oops'"),
+    ("columns", r"positions\.txt:13: expected 66 values, found 65"),
+])
+def test_corrupted_positions_name_the_line(shared_data, tmp_path, how, pattern):
+    folder = shared_data / "kinect_v2_vicon_uiprmd" / "Kinect"
+    shutil.copy(folder / "m01_s01_e01_angles.txt", tmp_path / "m01_s01_e01_angles.txt")
+    lines = (folder / "m01_s01_e01_positions.txt").read_text().splitlines(keepends=True)
+    fields = lines[12].strip().split(",")
+    if how == "truncated":
+        lines = lines[:12] + [",".join(fields[:30])]
+    elif how == "columns":
+        lines[12] = ",".join(fields[:-1]) + "\n"
+    else:
+        fields[4] = "nan" if how == "nan" else "oops"
+        lines[12] = ",".join(fields) + "\n"
+    (tmp_path / "m01_s01_e01_positions.txt").write_text("".join(lines))
+    with pytest.raises(TakeError, match=pattern):
+        load_take(tmp_path / "m01_s01_e01_positions.txt")
