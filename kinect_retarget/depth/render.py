@@ -25,7 +25,7 @@ def quad_sampler(rest_vertices: np.ndarray, quads: np.ndarray, min_distance: flo
     """Per-quad bilinear sample weights, grouped by density: [(quad indices, weights (n*n, 4))]."""
     corners = rest_vertices[quads]
     edge = np.max(np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=-1), axis=1)
-    n = np.clip(np.ceil(edge * cam.f / min_distance * 1.3), 2, 24).astype(int)
+    n = np.clip(np.ceil(edge * cam.f / min_distance * 1.1), 2, 24).astype(int)
     groups = []
     for k in np.unique(n):
         s = (np.arange(k) + 0.5) / k

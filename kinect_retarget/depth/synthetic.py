@@ -30,6 +30,7 @@ class Scenario:
     second_person: tuple | None = None   # (x, z) of a bystander standing still, or None
     boxes: list = field(default_factory=list)
     enter_exit: bool = False         # performer walks in from the side at the start and out at the end
+    turn_deg: float = 0.0            # turn the performer away from facing the sensor (occludes one side)
     noise_raw: float = 0.4
     seed: int = 0
 
@@ -61,7 +62,7 @@ def _placement(cmu: dict, sc: Scenario, nf: int, fps: float):
     fwd = np.cross(lat, [0.0, 1.0, 0.0])
     fwd[1] = 0
     ang = np.arctan2(fwd[0], fwd[2])  # heading about Y, relative to +Z
-    turn = np.pi - ang                 # rotate so the performer faces -Z (toward the sensor)
+    turn = np.pi - ang + np.radians(sc.turn_deg)  # face -Z (toward the sensor), then turn as asked
     c, s = np.cos(turn), np.sin(turn)
     yaw = np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
     root = (cmu["hips"] @ yaw.T)[:, [0, 2]]
@@ -93,7 +94,7 @@ def render_sequence(bvh_path: str, mesh_dir: str, scenario: Scenario | None = No
     yaw, shift = _placement(cmu, sc, nf, fps)
     to_cam = _tilt(sc.tilt_deg).T  # level frame -> camera frame
     room = Room(boxes=list(sc.boxes))
-    groups = quad_sampler(body.rest_vertices, body.quads, 1.2, cam)
+    groups = quad_sampler(body.rest_vertices, body.quads, 1.4, cam)  # dense enough from 1.4 m
     background = room_depth(room, cam, sc.tilt_deg)
     bystander = None
     if sc.second_person is not None:  # a second person standing still (the body's first frame, turned)
