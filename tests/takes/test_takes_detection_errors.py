@@ -193,3 +193,29 @@ def test_empty_json_and_uiprmd(tmp_path):
     from kinect_retarget.takes import kinectron_json
     with pytest.raises(TakeError, match=r"list\.json: recording has no frames"):
         kinectron_json.read(tmp_path / "list.json")
+
+
+@pytest.mark.parametrize("rel", sorted(REAL) + ["uiprmd:m05_s01_e01_angles.txt", "fixture:ntu", "fixture:msrc12",
+                                                "fixture:utkinect"])
+def test_every_reader_take_saves_as_krtake(shared_data, tmp_path, rel):
+    """Whatever was read can be saved in the project's format and read back unchanged (metadata too)."""
+    import numpy as np
+    from kinect_retarget.core.skeletons import NOT_TRACKED
+    from kinect_retarget.takes import krtake
+    if rel.startswith("fixture:"):
+        path = fx.FIXTURES / {"ntu": "S001C001P001R001A001_converted_Ges01.skeleton",
+                              "msrc12": "P1_1_1_converted_joints.csv",
+                              "utkinect": "joints_s01_e01_converted_joints.txt"}[rel[8:]]
+    elif rel.startswith("uiprmd:"):
+        path = shared_data / "kinect_v2_vicon_uiprmd" / "Kinect" / rel[7:]
+    else:
+        path = shared_data / rel
+    take = load_take(path)
+    krtake.write(tmp_path / "saved.krtake", take)
+    back = krtake.read(tmp_path / "saved.krtake")
+    assert back.skeleton is take.skeleton and back.rate == take.rate
+    np.testing.assert_array_equal(back.states, take.states)
+    seen = take.states != NOT_TRACKED
+    np.testing.assert_allclose(back.positions[seen], take.positions[seen], atol=5e-6)
+    np.testing.assert_allclose(back.times, take.times, atol=1e-6)
+    assert back.metadata == json.loads(json.dumps(take.metadata))
