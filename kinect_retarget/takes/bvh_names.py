@@ -163,25 +163,38 @@ def canonical(name: str) -> str:
     return name
 
 
+def _common_prefix(names: list[str] | tuple[str, ...]) -> str:
+    """A prefix every joint name shares and that ends at a separator ('Character1_', 'rig.', 'mixamorig_')."""
+    import os.path
+    prefix = os.path.commonprefix([n for n in names if not n.endswith("_end")])
+    cut = max(prefix.rfind(c) for c in "_.: |-")
+    return prefix[:cut + 1] if cut >= 0 else ""
+
+
 def resolve(bvh_names: list[str] | tuple[str, ...], kinect_joints: tuple[str, ...]
             ) -> tuple[str, dict[str, tuple[int, ...]]] | tuple[None, dict[str, list[str]]]:
     """Map each Kinect joint to BVH joint indices (averaged).
 
     Returns (family, {kinect joint: indices}) on success, or (None, {family: [unresolved kinect joints]}).
+    Names are tried as they are, then without a prefix that all of them share ('Character1_Hips').
     """
-    index = {}
-    for i, n in enumerate(bvh_names):
-        index.setdefault(canonical(n), i)
+    prefix = _common_prefix(bvh_names)
+    attempts = [bvh_names] + ([[n[len(prefix):] for n in bvh_names]] if prefix else [])
     missing: dict[str, list[str]] = {}
-    for family, table in FAMILIES.items():
-        mapping: dict[str, tuple[int, ...]] = {}
-        for joint in kinect_joints:
-            for alt in table.get(joint, []):
-                if all(canonical(n) in index for n in alt):
-                    mapping[joint] = tuple(index[canonical(n)] for n in alt)
-                    break
-        unresolved = [j for j in kinect_joints if j not in mapping]
-        if not unresolved:
-            return family, mapping
-        missing[family] = unresolved
+    for names in attempts:
+        index = {}
+        for i, n in enumerate(names):
+            index.setdefault(canonical(n), i)
+        for family, table in FAMILIES.items():
+            mapping: dict[str, tuple[int, ...]] = {}
+            for joint in kinect_joints:
+                for alt in table.get(joint, []):
+                    if all(canonical(n) in index for n in alt):
+                        mapping[joint] = tuple(index[canonical(n)] for n in alt)
+                        break
+            unresolved = [j for j in kinect_joints if j not in mapping]
+            if not unresolved:
+                return family, mapping
+            if names is bvh_names:
+                missing[family] = unresolved
     return None, missing

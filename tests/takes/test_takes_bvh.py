@@ -142,7 +142,9 @@ def test_explicit_scale_and_unit_heuristic(shared_data, tmp_path):
     spine = lambda t: np.linalg.norm(t.positions[:, k("Head")] - t.positions[:, k("HipCenter")], axis=-1)
     np.testing.assert_allclose(spine(take), spine(ref) * 0.05 / CMU_UNIT)
     # Unknown naming (joints renamed) still reads its skeleton; units come from the rest height.
-    renamed = src.replace("JOINT ", "JOINT x_").replace("ROOT Hips", "ROOT x_Hips")
+    (tmp_path / "prefixed.bvh").write_text(src.replace("JOINT ", "JOINT x_").replace("ROOT Hips", "ROOT x_Hips"))
+    assert bvh.read_bvh_skeleton(tmp_path / "prefixed.bvh").family == "cmu_3dsmax"  # shared prefix dropped
+    renamed = src.replace("JOINT ", "JOINT j").replace("ROOT Hips", "ROOT jHips")
     (tmp_path / "renamed.bvh").write_text(renamed)
     motion = bvh.read_bvh_skeleton(tmp_path / "renamed.bvh")
     assert motion.family is None and motion.units_to_metres == pytest.approx(CMU_UNIT)
@@ -220,6 +222,11 @@ RENAMES = {  # CMU MotionBuilder name -> the same joint in other rig families (L
                "{L}Arm": "DEF-upper_arm.{s}", "{L}ForeArm": "DEF-forearm.{s}", "{L}Hand": "DEF-hand.{s}",
                "{s}Fingers": "DEF-f_middle.01.{s}", "{L}UpLeg": "DEF-thigh.{s}", "{L}Leg": "DEF-shin.{s}",
                "{L}Foot": "DEF-foot.{s}", "{L}ToeBase": "DEF-toe.{s}"},
+    "cmu_motionbuilder": {n: f"Character1_{n}" for n in ("Hips", "LowerBack", "Spine", "Spine1", "Neck", "Neck1",
+                                                          "Head", "{L}Arm", "{L}ForeArm", "{L}Hand",
+                                                          "{L}FingerBase", "{s}Fingers", "{s}Thumb",
+                                                          "{L}UpLeg", "{L}Leg", "{L}Foot", "{L}ToeBase",
+                                                          "{L}Shoulder", "{s}HipJoint")},
     "mixamo": {n: f"mixamorig:{n}" for n in ("Hips", "Spine", "Spine1", "Head", "{L}Arm", "{L}ForeArm",
                                             "{L}Hand", "{L}UpLeg", "{L}Leg", "{L}Foot", "{L}ToeBase")}
     | {"{s}Fingers": "mixamorig:{L}HandMiddle1", "{L}FingerBase": "mixamorig:{L}HandRoot"},
