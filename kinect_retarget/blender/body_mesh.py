@@ -19,7 +19,7 @@ SIDES = tuple(SIDE_COLOURS)
 
 # Bones that are detail rather than body (Rigify face and fingers, Mixamo fingers...): no capsule.
 _DETAIL = re.compile(r"(^|[^a-z])(f_|thumb|palm|finger|index|middle|ring|pinky|lip|lid|brow|cheek|nose|ear|"
-                     r"jaw|chin|tongue|teeth|eye|forehead|temple|breast)", re.IGNORECASE)
+                     r"jaw|chin|tongue|teeth|eye|forehead|temple|breast|special|oris|levator|risorius|orbicularis|temporalis)", re.IGNORECASE)
 _BODY_PARTS = (  # (pattern on the bone name, capsule radius as a fraction of the character's height)
     (re.compile(r"head|skull|spine\.006", re.I), 0.055),
     (re.compile(r"neck|spine\.00[45]|vc4", re.I), 0.030),
@@ -29,8 +29,8 @@ _BODY_PARTS = (  # (pattern on the bone name, capsule radius as a fraction of th
     (re.compile(r"thigh|upleg|upperleg|knee", re.I), 0.040),
     (re.compile(r"shin|[^p]leg|lowerleg|calf|ankle", re.I), 0.031),
     (re.compile(r"foot|toe", re.I), 0.022),
-    (re.compile(r"upper_?arm|elbow|(^|[^e])arm", re.I), 0.026),
     (re.compile(r"forearm|lowerarm|wrist", re.I), 0.022),
+    (re.compile(r"upper_?arm|elbow|(^|[^e])arm", re.I), 0.026),
     (re.compile(r"hand", re.I), 0.020),
 )
 MIN_BONE_FRACTION = 0.025  # bones shorter than this fraction of the height are detail (fingers, twist ends)

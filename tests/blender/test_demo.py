@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
-from kinect_retarget.blender.body_mesh import add_body_mesh, body_bones
+from kinect_retarget.blender.body_mesh import add_body_mesh, body_bones, bone_radius
 from kinect_retarget.blender.render import stage_and_render
 from kinect_retarget.takes import kinect_v2_csv
 
@@ -114,3 +114,23 @@ def test_add_body_mesh_rejects_what_it_cannot_bind(baked_rig):
         add_body_mesh(baked_rig, bones=["HandRight", "Tail"])
     with pytest.raises(ValueError, match="no deform bone"):
         add_body_mesh(baked_rig, bones=[])
+
+
+@pytest.mark.parametrize("part, names", [
+    ("upper arm", ["ElbowLeft", "DEF-upper_arm.L", "mixamorig:LeftArm", "upperarm01.L", "upper_arm.R"]),
+    ("forearm", ["WristRight", "DEF-forearm.R.001", "mixamorig:RightForeArm", "lowerarm02.R", "forearm.L"]),
+    ("thigh", ["KneeLeft", "DEF-thigh.L", "mixamorig:LeftUpLeg", "upperleg02.L"]),
+    ("shin", ["AnkleRight", "DEF-shin.R", "mixamorig:RightLeg", "lowerleg01.R"]),
+    ("torso", ["SpineMid", "Spine", "ShoulderCenter", "HipCenter", "DEF-spine.002", "mixamorig:Hips"]),
+    ("head", ["Head", "DEF-spine.006", "mixamorig:Head", "head"]),
+])
+def test_bone_names_of_every_preset_get_the_same_capsule_per_body_part(part, names):
+    radii = {name: bone_radius(name, 0.3, 1.75) for name in names}
+    assert len(set(radii.values())) == 1, f"{part}: {radii}"
+
+
+def test_capsule_sizes_follow_the_body():
+    r = {name: bone_radius(name, 0.3, 1.75) for name in ("Head", "Neck", "SpineMid", "ElbowLeft", "WristLeft",
+                                                         "KneeLeft", "AnkleLeft", "HandLeft")}
+    assert r["SpineMid"] > r["Head"] > r["Neck"]
+    assert r["KneeLeft"] > r["AnkleLeft"] and r["ElbowLeft"] > r["WristLeft"] >= r["HandLeft"]
