@@ -12,7 +12,7 @@ import os
 
 import numpy as np
 
-from ..core.skeletons import KINECT_V2, NOT_TRACKED, TRACKED
+from ..core.skeletons import KINECT_V2, TRACKED
 from ..core.take import Take, TakeError, nominal_rate
 from ._numeric import read_bytes
 

@@ -8,7 +8,7 @@ import pytest
 
 from kinect_retarget.core.skeletons import KINECT_V2, NOT_TRACKED, TRACKED
 from kinect_retarget.core.take import TakeError
-from kinect_retarget.takes import detect_format, load_take, uiprmd
+from kinect_retarget.takes import detect_format, load_take
 
 FRAMES = {"m01": 73, "m05": 80, "m07": 63}  # deep squat, sit-to-stand, shoulder abduction
 
