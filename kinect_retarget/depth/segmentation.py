@@ -74,9 +74,16 @@ def fit_floor(grid: DepthGrid, gravity: np.ndarray | None, previous: FloorPlane 
     centre = band.mean(axis=0)
     _, _, vt = np.linalg.svd(band - centre, full_matrices=False)
     n = vt[2] if vt[2] @ up > 0 else -vt[2]
-    if n @ up < np.cos(np.radians(10)):  # the band is not a floor (tilted fit): trust gravity alone
-        n = up
-    return FloorPlane(n, -float(n @ centre))
+    spread = np.ptp(band - np.outer(band @ n, n), axis=0)
+    residual = float(np.sqrt(np.mean(((band - centre) @ n) ** 2)))
+    plane = FloorPlane(n, -float(n @ centre))
+    below = float(np.mean(plane.height(pts) < -0.08))
+    if (n @ up < np.cos(np.radians(10)) or residual > 0.03 or np.sort(spread)[-2] < 0.5
+            or below > 0.03 or plane.offset < 0.2):
+        # not a floor: legs cut by the image edge, a desk top with things below it, a surface above the
+        # sensor. Better no floor (nothing removed) than a wrong one (the person removed).
+        return previous if previous is not None and below <= 0.03 else None
+    return plane
 
 
 def connected_components(mask: np.ndarray, z: np.ndarray, max_jump: float) -> np.ndarray:
@@ -144,6 +151,9 @@ def find_people(grid: DepthGrid, floor: FloorPlane | None, gravity: np.ndarray |
         horiz = pts - np.outer(hts, up)
         width = float(np.max(np.ptp(horiz, axis=0)))
         if not (0.08 < area < 1.6 and 0.45 < vert < 2.4 and width < 1.6):
+            continue
+        sv = np.linalg.svd(pts[::4] - pts.mean(axis=0), compute_uv=False)
+        if sv[2] < 0.06 * sv[0]:  # flat: a wall or door seen through a gap, not a body
             continue
         if floor is not None and np.min(floor.height(pts)) > 0.9:  # floating blob (lamp, shelf item)
             continue
