@@ -39,7 +39,8 @@ def _mapped_ancestors(pose_bones, bone_names) -> tuple[list[int], list[int]]:
 
 def correct_for_evaluation(obj: bpy.types.Object, bone_names, quats: np.ndarray, root_bone: str | None,
                            root_location: np.ndarray, desired: np.ndarray, progress=None) -> np.ndarray:
-    """quats (F, M, 4) solved assuming plain parenting -> corrected quats, frame by frame through Blender.
+    """quats (F, M, 4) solved assuming plain parenting, desired (F, M, 4) armature-space rotations ->
+    corrected quats, frame by frame through Blender.
 
     Each evaluation corrects every bone top-down, predicting how a correction of an ancestor turns its
     descendants, so a pass usually lands within tolerance and a second evaluation confirms it."""
@@ -57,6 +58,7 @@ def correct_for_evaluation(obj: bpy.types.Object, bone_names, quats: np.ndarray,
         if root_bone is not None:
             pose_bones[root_bone].location = root_location[f].tolist()
         basis = plain[f] @ carry
+        wanted = to_matrix(desired[f])
         for _ in range(MAX_PASSES):
             _set_rotations(pose_bones, bone_names, from_matrix(basis))
             obj.update_tag()
@@ -70,12 +72,12 @@ def correct_for_evaluation(obj: bpy.types.Object, bone_names, quats: np.ndarray,
             for k in order:
                 a = anchor[k]
                 predicted = turned[a] @ actual[k] if a >= 0 else actual[k]
-                err = predicted.T @ desired[f, k]  # predicted -> desired, in bone space
+                err = predicted.T @ wanted[k]  # predicted -> desired, in bone space
                 # sin of the residual angle from the skew part: exact near zero, unlike arccos of the trace
                 worst = max(worst, np.linalg.norm([err[2, 1] - err[1, 2], err[0, 2] - err[2, 0],
                                                    err[1, 0] - err[0, 1]]) / 2)
                 basis[k] = basis[k] @ err
-                turned[k] = desired[f, k] @ actual[k].T
+                turned[k] = wanted[k] @ actual[k].T
             if worst < TOLERANCE:
                 break
         out[f] = from_matrix(basis)

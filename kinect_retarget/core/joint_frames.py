@@ -48,14 +48,15 @@ def role_and_side(joint: str) -> tuple[str, str]:
     return ROLES[joint], ""
 
 
-def resolver(names: tuple[str, ...], positions: np.ndarray) -> GetJoint:
-    """Lookup of (..., 3) joint positions by canonical name; None when the skeleton lacks the joint."""
+def resolver(names: tuple[str, ...], positions: np.ndarray, joint_axis: int = -2) -> GetJoint:
+    """Lookup of (..., 3) joint positions by canonical name; None when the skeleton lacks the joint.
+    positions has joints on `joint_axis` (-2 for (..., J, 3), 0 for joint-major (J, ..., 3))."""
     index = {n: i for i, n in enumerate(names)}
 
     def get(name: str):
         for alias in ALIASES.get(name, (name,)):
             if alias in index:
-                return positions[..., index[alias], :]
+                return positions[index[alias]] if joint_axis == 0 else positions[..., index[alias], :]
         return None
     return get
 

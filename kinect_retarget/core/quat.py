@@ -47,32 +47,37 @@ def to_matrix(q: np.ndarray) -> np.ndarray:
 def from_matrix(m: np.ndarray) -> np.ndarray:
     """(..., 3, 3) rotation matrices -> (..., 4) unit quaternions with w >= 0.
 
-    Picks, per matrix, the largest of 4w², 4x², 4y², 4z² as the pivot, so it is exact near 180° too.
-    """
+    Where w is large the trace formula is exact and cheap; elsewhere (rotations beyond ~140°) the largest of
+    the four components is the pivot, so the result stays exact near 180° too."""
     m = np.asarray(m, dtype=np.float64)
-    m00, m11, m22 = m[..., 0, 0], m[..., 1, 1], m[..., 2, 2]
+    q = np.empty(m.shape[:-2] + (4,))
+    t = 1 + m[..., 0, 0] + m[..., 1, 1] + m[..., 2, 2]  # 4w²
+    big = t > 0.5
+    if np.all(big):
+        s = 2 * np.sqrt(t)  # 4w
+        q[..., 0] = s / 4
+        q[..., 1] = (m[..., 2, 1] - m[..., 1, 2]) / s
+        q[..., 2] = (m[..., 0, 2] - m[..., 2, 0]) / s
+        q[..., 3] = (m[..., 1, 0] - m[..., 0, 1]) / s
+        return q
+    q[big] = from_matrix(m[big]) if np.any(big) else q[big]
+    q[~big] = _from_matrix_pivot(m[~big])
+    return q
+
+
+def _from_matrix_pivot(m: np.ndarray) -> np.ndarray:
+    """(N, 3, 3) -> (N, 4): divide by the largest of 4w², 4x², 4y², 4z² (robust at any angle)."""
+    m00, m11, m22 = m[:, 0, 0], m[:, 1, 1], m[:, 2, 2]
     cand = np.stack([1 + m00 + m11 + m22, 1 + m00 - m11 - m22, 1 - m00 + m11 - m22, 1 - m00 - m11 + m22], -1)
     pick = np.argmax(cand, axis=-1)
-    s = np.sqrt(np.maximum(np.take_along_axis(cand, pick[..., None], -1)[..., 0], 1e-300)) * 2  # = 4 * pivot
-    a = m[..., 2, 1] - m[..., 1, 2]
-    b = m[..., 0, 2] - m[..., 2, 0]
-    c = m[..., 1, 0] - m[..., 0, 1]
-    d = m[..., 0, 1] + m[..., 1, 0]
-    e = m[..., 0, 2] + m[..., 2, 0]
-    f = m[..., 1, 2] + m[..., 2, 1]
-    q = np.empty(m.shape[:-2] + (4,))
-    rows = [
-        (s / 4, a / s, b / s, c / s),
-        (a / s, s / 4, d / s, e / s),
-        (b / s, d / s, s / 4, f / s),
-        (c / s, e / s, f / s, s / 4),
-    ]
-    for k, row in enumerate(rows):
-        sel = pick == k
-        for i in range(4):
-            q[..., i] = np.where(sel, row[i], q[..., i]) if k else row[i]
-    q *= np.where(q[..., :1] < 0, -1.0, 1.0)
-    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+    s = 2 * np.sqrt(np.maximum(cand[np.arange(len(m)), pick], 1e-300))  # 4 × the pivot component
+    a, b, c = m[:, 2, 1] - m[:, 1, 2], m[:, 0, 2] - m[:, 2, 0], m[:, 1, 0] - m[:, 0, 1]
+    d, e, f = m[:, 0, 1] + m[:, 1, 0], m[:, 0, 2] + m[:, 2, 0], m[:, 1, 2] + m[:, 2, 1]
+    rows = np.stack([
+        np.stack([s / 4, a / s, b / s, c / s], -1), np.stack([a / s, s / 4, d / s, e / s], -1),
+        np.stack([b / s, d / s, s / 4, f / s], -1), np.stack([c / s, e / s, f / s, s / 4], -1)], 1)
+    q = rows[np.arange(len(m)), pick]
+    return q * np.where(q[:, :1] < 0, -1.0, 1.0)
 
 
 def make_continuous(q: np.ndarray, axis: int = 0) -> np.ndarray:

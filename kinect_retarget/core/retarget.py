@@ -19,7 +19,7 @@ import numpy as np
 
 from .conventions import KINECT_TO_BLENDER
 from .joint_frames import ALIASES, frame_from_y_hint, resolver, segment_hint
-from .quat import from_matrix
+from .quat import conjugate, from_matrix, mul, rotate
 from .skeletons import Skeleton
 from .target_rig import TargetRig
 
@@ -128,6 +128,7 @@ class Retargeter:
             o_t = frame_from_y_hint(y, np.nan_to_num(hint))
             self.constants[k] = o_t.T @ rig.rest[m.index, :3, :3]
         self._chain_plan()
+        self.constants_q = from_matrix(self.constants)
         self.root_scale = root_scale
 
     def _chain_plan(self) -> None:
@@ -156,6 +157,7 @@ class Retargeter:
             else:  # reached the top: armature space
                 self.static[k] = rig.rest[child, :3, :3] @ chain
         self.has_anchor = self.anchor >= 0
+        self.static_q = from_matrix(self.static)
 
     def scale_for(self, source_leg: float | None) -> float:
         """Root scale n (eq. 13): target leg / source leg, unless fixed."""
@@ -170,28 +172,32 @@ class Retargeter:
         """positions (F, J, 3) Kinect camera space -> quats (F, M, 4) for self.bone_names, and the root bone's
         pose location (F, 3) (zeros without a mapped root). root_reference: Kinect position of the root joint
         that maps to the rest position (the take's first keyed frame). With want_desired, also the desired
-        armature-space bone rotations (F, M, 3, 3), for rigs whose constraints need Blender's evaluation."""
-        p = np.asarray(positions, dtype=np.float64) @ self.arm_from_kinect.T
-        nframes = p.shape[0]
-        get = resolver(self.skeleton.joints, p)
+        armature-space bone rotations (F, M, 4), for rigs whose constraints need Blender's evaluation."""
+        # joint-major layout (J, F, 3): every per-joint slice below is contiguous, which numpy handles fastest
+        p = np.ascontiguousarray(np.swapaxes(np.asarray(positions, dtype=np.float64) @ self.arm_from_kinect.T, 0, 1))
+        nframes = p.shape[1]
+        get = resolver(self.skeleton.joints, p, joint_axis=0)
         cache: dict = {}
-        y = np.stack([p[:, m.tail] - p[:, m.head] for m in self.mapped], axis=1)
-        hints = np.stack([segment_hint(get, m.tail_name, y[:, k], self.world_lateral, self.world_up, cache)
-                          for k, m in enumerate(self.mapped)], axis=1)
-        desired = frame_from_y_hint(y, hints) @ self.constants          # (F, M, 3, 3), eq. 11
-        frame_rot = np.broadcast_to(self.static, desired.shape).copy()
+        y = np.stack([p[m.tail] - p[m.head] for m in self.mapped])                    # (M, F, 3)
+        hints = np.stack([segment_hint(get, m.tail_name, y[k], self.world_lateral, self.world_up, cache)
+                          for k, m in enumerate(self.mapped)])
+        # quaternion products are cheaper than stacks of 3x3 matrix products
+        desired = mul(from_matrix(frame_from_y_hint(y, hints)), self.constants_q[:, None])  # (M, F, 4), eq. 11
+        frame_rot = np.broadcast_to(self.static_q[:, None], desired.shape).copy()
         if self.has_anchor.any():
-            frame_rot[:, self.has_anchor] = desired[:, self.anchor[self.has_anchor]] @ self.static[self.has_anchor]
-        basis = np.swapaxes(frame_rot, -1, -2) @ desired                  # eq. 12
-        quats = from_matrix(basis)
+            frame_rot[self.has_anchor] = mul(desired[self.anchor[self.has_anchor]],
+                                             self.static_q[self.has_anchor, None])
+        quats = np.swapaxes(mul(conjugate(frame_rot), desired), 0, 1)                   # (F, M, 4), eq. 12
         location = np.zeros((nframes, 3))
         if self.root is not None and self.root_mode != "none" and nframes:
-            ref = p[0, self.root.head] if root_reference is None else root_reference @ self.arm_from_kinect.T
-            delta = (p[:, self.root.head] - ref) * self.scale_for(source_leg)
+            ref = p[self.root.head, 0] if root_reference is None else root_reference @ self.arm_from_kinect.T
+            delta = (p[self.root.head] - ref) * self.scale_for(source_leg)
             if self.root_mode == "xy":
                 delta -= np.outer(delta @ self.world_up, self.world_up)
             k = self.mapped.index(self.root)
-            location = np.einsum("...ji,...j->...i", frame_rot[:, k], delta)
+            location = rotate(conjugate(frame_rot[k]), delta)
+        if want_desired:
+            desired = np.swapaxes(desired, 0, 1)
         return (quats, location, desired) if want_desired else (quats, location)
 
 
