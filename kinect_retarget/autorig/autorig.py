@@ -59,13 +59,14 @@ def _check_single_body(mesh: Mesh, comp: np.ndarray) -> None:
                         f"({sizes[0]} and {sizes[1]} vertices): several bodies? Rig one character at a time")
 
 
-def _nearest(points: np.ndarray, targets: np.ndarray, chunk: int = 2048) -> np.ndarray:
-    """Index of the nearest target for each point (brute force in chunks: no scipy in Blender)."""
+def _nearest(points: np.ndarray, targets: np.ndarray, chunk: int = 1024) -> np.ndarray:
+    """Index of the nearest target for each point (brute force in float32 chunks: no scipy in Blender)."""
     out = np.empty(len(points), dtype=np.int64)
-    t2 = (targets ** 2).sum(axis=1)
+    t = targets.astype(np.float32)
+    t2 = (t ** 2).sum(axis=1)
     for s in range(0, len(points), chunk):
-        p = points[s:s + chunk]
-        out[s:s + chunk] = np.argmin(t2[None, :] - 2 * p @ targets.T, axis=1)
+        p = points[s:s + chunk].astype(np.float32)
+        out[s:s + chunk] = np.argmin(t2[None, :] - 2 * p @ t.T, axis=1)
     return out
 
 
@@ -104,7 +105,8 @@ def autorig(mesh: Mesh, levels: int = LEVELS) -> AutoRig:
     seg_all[body] = segment
     others = np.setdiff1d(np.arange(len(mesh.vertices)), body)
     if len(others):
-        seg_all[others] = segment[_nearest(mesh.vertices[others], v)]
+        sample = np.arange(0, len(v), 4)  # a quarter of the body is plenty to tell which part a piece sits on
+        seg_all[others] = segment[sample[_nearest(mesh.vertices[others], v[sample])]]
     index, weight = bone_projection_weights(mesh.vertices, seg_all, joints, height, graph)
     timings["weights"] = time.perf_counter() - t0
     report = {"body_vertices": int(len(body)), "components": int(comp.max()) + 1,

@@ -134,4 +134,21 @@ def find_feature_points(vertices: np.ndarray, graph: MeshGraph) -> FeaturePoints
     hl, hr = split(hands)
     fl, fr = split(feet)
     sel = [head, hl, hr, fl, fr]
-    return FeaturePoints(tips[sel], fields[sel], up, front, left, float(ratio))
+    tips, fields = _refine_tips(graph, tips[sel], fields[sel])
+    return FeaturePoints(tips, fields, up, front, left, float(ratio))
+
+
+def _refine_tips(graph: MeshGraph, tips: np.ndarray, fields: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Move each tip to the vertex of its own segment farthest from the other four tips. Farthest-point
+    sampling finds one point per extremity, but not always its end: with the arms out, the lower back can
+    be sampled before the head, which then gets the chin instead of the crown."""
+    segment = np.argmin(fields, axis=0)
+    tips, fields = tips.copy(), fields.copy()
+    for i in range(len(tips)):
+        others = np.delete(np.arange(len(tips)), i)
+        score = np.where(segment == i, fields[others].sum(axis=0), -np.inf)
+        best = int(np.argmax(score))
+        if best != tips[i]:
+            tips[i] = best
+            fields[i] = dijkstra(graph, [best])
+    return tips, fields

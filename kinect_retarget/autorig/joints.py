@@ -20,7 +20,8 @@ from .features import FeaturePoints
 ARM = {"WristLeft": 0.110, "ElbowLeft": 0.222, "ShoulderLeft": 0.335}
 HAND_AT = (0.047, 0.5)   # the palm: half-way from the wrist to the ring across the finger roots
 LEG = {"FootLeft": 0.085, "AnkleLeft": 0.125, "KneeLeft": 0.31}
-THIGH_TOP = 0.46         # foot field: the top of the thigh, level with the crotch
+PELVIS_AT = 0.44         # head field: a cross-section of the pelvis just above the crotch
+HIP_HALF_WIDTH = 0.058   # hip joints: this far to each side of the hip centre
 TORSO = {"ShoulderCenter": 0.193, "Spine": 0.36, "HipCenter": 0.48}  # head field, inside the trunk
 HEAD_DOWN = 0.30         # Head joint: this far from the top toward the neck base
 
@@ -36,6 +37,17 @@ def ring_centroid(vertices: np.ndarray, field: np.ndarray, g: float, width: floa
             return vertices[band].mean(axis=0)
     near = np.argmin(np.abs(field - g) + (0 if mask is None else np.where(mask, 0, np.inf)))
     return vertices[near].copy()
+
+
+def _cross_section_axis(vertices, field, g, width, mask, normal) -> np.ndarray:
+    """Unit long axis of the ring at g, in the plane normal to `normal` (principal component)."""
+    for w in (width, 2 * width, 4 * width):
+        band = (np.abs(field - g) < w) & mask
+        if band.sum() >= 3:
+            break
+    p = vertices[band] - vertices[band].mean(axis=0)
+    p -= np.outer(p @ normal, normal)
+    return np.linalg.eigh(p.T @ p)[1][:, -1]
 
 
 def body_length(fp: FeaturePoints) -> float:
@@ -75,14 +87,14 @@ def kinect_joints(vertices: np.ndarray, fp: FeaturePoints, segment: np.ndarray, 
         depth = vertices[slab] @ fp.front
         head += fp.front * ((depth.min() + depth.max()) / 2 - head @ fp.front)
     out[idx("Head")] = head
-    # Hips: level with the hip centre, as far to each side as the tops of the thighs are (the femur heads
-    # sit level with the pelvis centre whatever the legs do; a flexed thigh's ring is tilted, not moved).
+    # Hips: level with the hip centre, half a pelvis width to each side along the pelvis's own left-right
+    # axis (the long axis of the trunk's cross-section just above the crotch). The thighs' own rings do
+    # not give it: a flexed or spread leg drags them forward, back or outward.
     hip_centre = out[idx("HipCenter")]
     trunk = neck - hip_centre
     trunk /= max(np.linalg.norm(trunk), 1e-12)
-    tops = [ring_centroid(vertices, fp.distances[s], THIGH_TOP * size, width) for s in (3, 4)]
-    lateral = (tops[0] - tops[1]) / 2
-    lateral -= trunk * (lateral @ trunk)
-    out[idx("HipLeft")] = hip_centre + lateral
-    out[idx("HipRight")] = hip_centre - lateral
+    lateral = _cross_section_axis(vertices, head_f, PELVIS_AT * size, 3 * width, in_trunk, trunk)
+    lateral *= np.sign(lateral @ fp.left) or 1.0
+    out[idx("HipLeft")] = hip_centre + HIP_HALF_WIDTH * size * lateral
+    out[idx("HipRight")] = hip_centre - HIP_HALF_WIDTH * size * lateral
     return out

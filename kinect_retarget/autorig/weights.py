@@ -77,23 +77,25 @@ def projection_matrix(vertices: np.ndarray, segment: np.ndarray, joints: np.ndar
 
 
 def smooth_over_surface(w: np.ndarray, indptr: np.ndarray, indices: np.ndarray, iterations: int) -> np.ndarray:
-    """Jacobi steps of w <- (w + mean of neighbours) / 2 over the CSR adjacency: blends the hard switch
+    """Jacobi steps of w <- w / 4 + 3/4 mean of neighbours over the CSR adjacency: blends the hard switch
     where two bones' projections meet over a few edge lengths (shoulder, ankle, groin)."""
-    deg = np.diff(indptr)
+    w = w.astype(np.float32)  # half the memory traffic; weights need no more precision
+    deg = np.diff(indptr).astype(np.float32)
     has = deg > 0
     starts = indptr[:-1][has]
     for _ in range(iterations):
         acc = np.add.reduceat(w[indices], starts, axis=0) if len(indices) else np.zeros((0, w.shape[1]))
         mean = w.copy()
         mean[has] = acc / deg[has, None]
-        w = 0.5 * (w + mean)
-    return w
+        w = 0.25 * w + 0.75 * mean
+    return w.astype(np.float64)
 
 
 def smoothing_iterations(edge_lengths: np.ndarray, height: float, blend: float = 0.03) -> int:
-    """Steps that diffuse over about `blend` x height (diffusion spreads as the square root of steps)."""
+    """Steps that diffuse over about `blend` x height (diffusion spreads as the square root of steps; a
+    3/4 step spreads 1.5 times as far as a half step)."""
     e = float(np.median(edge_lengths)) if len(edge_lengths) else height
-    return int(np.clip((blend * height / max(e, 1e-12)) ** 2, 2, 40))
+    return int(np.clip((blend * height / max(e, 1e-12)) ** 2 / 1.5, 2, 20))
 
 
 def top_influences(w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
