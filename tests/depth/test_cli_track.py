@@ -1,0 +1,63 @@
+"""`python -m kinect_retarget track`: capture .npz -> take; clear errors for bad input."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from kinect_retarget.cli import main
+from kinect_retarget.core.skeletons import NOT_TRACKED
+from kinect_retarget.takes import load_take
+
+
+def test_track_capture_writes_a_take(rendered, tmp_path, capsys):
+    seq, path = rendered
+    out = tmp_path / "hop.krtake"
+    assert main(["track", str(path), "--out", str(out)]) == 0
+    take = load_take(out)
+    assert take.frame_count == len(seq.mm) and take.skeleton.name == "kinect_v1"
+    np.testing.assert_allclose(take.times, seq.times, atol=1e-6)
+    assert np.all(take.states != NOT_TRACKED)
+    assert np.mean(np.linalg.norm(take.positions - seq.joints, axis=-1)) < 0.1
+    assert "skeleton in 100 %" in capsys.readouterr().out
+
+
+def test_track_raw_only_capture_with_device_ticks(rendered, tmp_path):
+    seq, _ = rendered
+    path = tmp_path / "raw.npz"
+    ticks = (seq.times * 60_000_000).astype(np.int64) + (1 << 32) - 3_000_000   # the clock wraps mid-take
+    np.savez(path, raw=seq.raw[:4], timestamp=ticks[:4] % (1 << 32))
+    out = tmp_path / "raw.krtake"
+    assert main(["track", str(path), "--out", str(out)]) == 0
+    take = load_take(out)
+    np.testing.assert_allclose(take.times, seq.times[:4] - seq.times[0], atol=1e-6)
+
+
+@pytest.mark.parametrize("content, message", [
+    ({"mm": np.zeros((2, 240, 320), np.uint16)}, "expected (frames, 480, 640)"),
+    ({"depth": np.zeros((2, 480, 640), np.uint16)}, "expected an array named 'mm' or 'raw'"),
+    ({"mm": np.zeros((2, 480, 640), np.uint16), "times": np.array([0.1, 0.1])}, "frame 1 is not later"),
+    ({"mm": np.zeros((3, 480, 640), np.uint16), "times": np.array([0.0, 0.1])}, "3 depth frames but 2"),
+])
+def test_bad_captures_are_clear_errors(tmp_path, capsys, content, message):
+    path = tmp_path / "bad.npz"
+    np.savez(path, **content)
+    assert main(["track", str(path), "--out", str(tmp_path / "x.krtake")]) == 2
+    err = capsys.readouterr().err
+    assert message in err and str(path) in err and "Traceback" not in err
+
+
+def test_not_an_npz_and_missing_file(tmp_path, capsys):
+    junk = tmp_path / "junk.npz"
+    junk.write_bytes(b"this is not numpy")
+    assert main(["track", str(junk), "--out", str(tmp_path / "x.krtake")]) == 2
+    assert "not a readable depth capture" in capsys.readouterr().err
+    assert main(["track", str(tmp_path / "nope.npz"), "--out", str(tmp_path / "x.krtake")]) == 2
+    assert "no such file" in capsys.readouterr().err
+
+
+def test_all_zero_capture_gives_an_untracked_take(tmp_path):
+    path = tmp_path / "empty.npz"
+    np.savez(path, mm=np.zeros((3, 480, 640), np.uint16))
+    out = tmp_path / "empty.krtake"
+    assert main(["track", str(path), "--out", str(out)]) == 0
+    assert np.all(load_take(out).states == NOT_TRACKED)
