@@ -92,12 +92,17 @@ class LiveController:
             bpy.context.view_layer.update()  # no viewport redraw to evaluate the constrained parents
 
     def _evaluated(self, obj) -> dict:
-        """Armature-space rotations of the constrained parents, as Blender last evaluated them."""
-        out = {}
-        for b, name in self._read:
-            m = np.array(obj.pose.bones[name].matrix, dtype=np.float64)[:3, :3]
-            out[b] = m / np.linalg.norm(m, axis=0, keepdims=True)  # drop pose scale
-        return out
+        """Armature-space rotations of the constrained parents, as Blender last evaluated them (one bulk read)."""
+        pose_bones = obj.pose.bones
+        if getattr(self, "_pose_index", None) is None or len(pose_bones) != self._pose_count:
+            keys = pose_bones.keys()
+            self._pose_index = np.array([keys.index(name) for _, name in self._read])
+            self._pose_count = len(pose_bones)
+            self._flat = np.empty(self._pose_count * 16, dtype=np.float32)
+        pose_bones.foreach_get("matrix", self._flat)
+        m = self._flat.reshape(-1, 4, 4)[self._pose_index, :3, :3].transpose(0, 2, 1).astype(np.float64)
+        m /= np.linalg.norm(m, axis=-2, keepdims=True)  # drop pose scale
+        return {b: m[k] for k, (b, _) in enumerate(self._read)}
 
     # -- pumping ---------------------------------------------------------------------------------------------
     def pump(self) -> bool:

@@ -46,9 +46,12 @@ class ConstrainedParentCorrection:
 
     def correct(self, quats: np.ndarray, evaluated: dict, desired: np.ndarray | None = None) -> np.ndarray:
         """quats (M, 4) solved for plain parenting -> quats that give the desired rotations under the actual
-        parents. evaluated: bone index -> (3, 3) armature-space rotation from the last evaluation."""
+        parents. evaluated: bone index -> (3, 3) armature-space rotation from the last evaluation; desired:
+        (M, 3, 3) matrices or (M, 4) quaternions, from the solver (else derived from quats)."""
         if desired is None:
             desired = self.desired_from_quats(quats)
+        elif np.shape(desired)[-1] == 4:  # the engine may hand desired rotations as quaternions
+            desired = to_matrix(desired)
         out = np.array(quats, dtype=np.float64)
         actual = {}
         rot = self.rig.rest[:, :3, :3]

@@ -47,3 +47,14 @@ def test_constrained_parent_offset_is_compensated_exactly_when_it_follows_its_pa
     assert np.degrees(angle_between(got, from_matrix(desired))).max() < 1e-8
     # without the correction the chain would be off by the offset
     assert np.degrees(angle_between(quats[1], fixed[1])) > 1.0
+
+
+def test_desired_may_come_as_quaternions(rng):
+    rig = chain_rig()
+    corr = ConstrainedParentCorrection(rig, ("root", "upper", "lower"), constrained_bones=("mch",))
+    quats = random_quats(rng, 3)
+    desired = corr.desired_from_quats(quats)
+    evaluated = {0: desired[0], 1: desired[0] @ to_matrix(random_quats(rng, 1)[0])}
+    a = corr.correct(quats, evaluated, desired)
+    b = corr.correct(quats, evaluated, from_matrix(desired))
+    assert np.degrees(angle_between(a, b)).max() < 1e-9
