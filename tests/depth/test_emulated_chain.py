@@ -57,3 +57,22 @@ def test_emulated_usb_depth_to_skeleton_frames_to_rig(rendered):
     got = normalize(posed[:, shin.index, :3, 1] @ rig.object_rotation.T)
     want = normalize(p[:, ankle] - p[:, knee])
     assert np.all(np.sum(got * want, -1) > np.cos(np.radians(2)))
+
+
+def test_preview_image_shows_person_and_skeleton(rendered):
+    from kinect_retarget.depth.preview import preview_rgba
+    from kinect_retarget.depth.tracker import SkeletonTracker
+    seq, _ = rendered
+    tr = SkeletonTracker(gravity=seq.gravity)
+    pos, st = tr.update(seq.mm[0], 0.0)
+    img = preview_rgba(seq.mm[0], tr.last_mask, pos, st)
+    assert img.shape == (240, 320, 4) and img.dtype == np.float32
+    assert np.all((img >= 0) & (img <= 1))
+    yellow = np.all(np.isclose(img[..., :3], [1.0, 0.85, 0.1]), axis=-1)
+    assert yellow.sum() > 50                                     # bones and joints drawn
+    # the head joint is drawn where it projects (rows bottom-up in Blender images)
+    u = (319.5 - 575 * pos[3, 0] / pos[3, 2]) / 2
+    v = (239.5 - 575 * pos[3, 1] / pos[3, 2]) / 2
+    assert yellow[239 - int(round(v)), int(round(u))]
+    empty = preview_rgba(np.zeros((480, 640), np.uint16), None, np.zeros((20, 3)), np.zeros(20, np.uint8))
+    assert np.all(empty[..., :3] == 0)
