@@ -105,3 +105,13 @@ def _edge_lengths(me):
     me.edges.foreach_get("vertices", e)
     e = e.reshape(-1, 2)
     return np.linalg.norm(co[e[:, 0]] - co[e[:, 1]], axis=1)
+
+
+def test_heat_weights_option(registered, body):
+    bpy = registered
+    obj = _add_body(bpy, body)
+    assert bpy.ops.kinect_retarget.autorig_mesh(weights="HEAT") == {"FINISHED"}
+    names, count, total = _weights(obj)
+    assert set(names.values()) >= set(KINECT_V1.joints)
+    assert count.max() <= 4 and count.min() >= 1
+    np.testing.assert_allclose(total, 1.0, atol=1e-3)

@@ -1,0 +1,35 @@
+"""`python -m kinect_retarget autorig` end to end (in-process: the CLI imports bpy itself)."""
+import json
+
+import pytest
+
+from kinect_retarget.cli import main
+
+
+def test_autorig_cli_bakes_and_renders(shared_data, tmp_path, capsys):
+    out = tmp_path / "mh.blend"
+    code = main(["autorig", str(shared_data / "meshes" / "makehuman" / "base.obj"), "--group", "body",
+                 "--out", str(out), "--take", str(shared_data / "kinect_v2" / "Ges04_comehere.csv"),
+                 "--render", str(tmp_path / "png"), "--frames", "2"])
+    assert code == 0
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert out.is_file() and summary["frames"] == 172
+    assert abs(summary["height_m"] - 1.666) < 0.01  # decimetres became metres
+    assert len(summary["renders"]) == 2 and all((tmp_path / "png" / p.split("/")[-1]).is_file()
+                                                for p in summary["renders"])
+    import bpy
+    bpy.ops.wm.open_mainfile(filepath=str(out))
+    arm = bpy.data.objects[summary["armature"]]
+    assert arm.animation_data.action.name == summary["action"]
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+
+
+@pytest.mark.parametrize("content, message", [(b"v 0 0 0\nv 1 0 0\nv 0 1 0\n", "no faces"),
+                                              (b"just text\n", "not a mesh file")])
+def test_autorig_cli_bad_input(tmp_path, capsys, content, message):
+    src = tmp_path / "thing.obj"
+    src.write_bytes(content)
+    assert main(["autorig", str(src), "--out", str(tmp_path / "o.blend")]) == 2
+    err = capsys.readouterr().err
+    assert message in err and "thing.obj" in err and "Traceback" not in err
+    assert not (tmp_path / "o.blend").exists()
