@@ -57,6 +57,12 @@ class DepthSkeletonProducer:
         with self._lock:
             return self._preview
 
+    def preview_image(self, scale: int = 2):
+        """RGBA float32 (rows bottom-up) of the newest frame for a Blender image, or None before the first."""
+        from .preview import preview_rgba
+        p = self.preview()
+        return None if p is None else preview_rgba(*p, camera=self.tracker.camera, scale=scale)
+
     def close(self) -> None:
         if self._own:
             self.stream.stop()
