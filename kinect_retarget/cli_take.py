@@ -38,7 +38,8 @@ def take_summary(path: str) -> dict:
     return {"file": os.path.basename(path), "format": detect_format(path), "skeleton": take.skeleton.name,
             "joints": len(take.skeleton), "frames": take.frame_count, "duration_s": round(take.duration, 3),
             "rate_fps": take.rate, "tracked_fraction": round(take.tracked_fraction, 4),
-            "frames_with_body": int(np.count_nonzero(take.any_tracked))}
+            "frames_with_body": int(np.count_nonzero(take.any_tracked)),
+            **({"warnings": take.metadata["warnings"]} if take.metadata.get("warnings") else {})}
 
 
 def run_info(args) -> int:

@@ -98,6 +98,12 @@ def read(path: str | os.PathLike) -> Take:
     lines = body.splitlines()
     while lines and not lines[-1].strip():
         lines.pop()
+    warnings_ = []
+    if lines and not body.endswith("\n") and len(lines[-1].split()) < ncol:
+        # a recording interrupted mid-write: keep every complete frame, say what was dropped
+        lines.pop()
+        warnings_.append(f"{path}:{len(lines) + 2}: last frame line was cut off (interrupted recording); "
+                         f"{len(lines)} complete frames loaded")
     values = _parse_rows(path, lines, ncol, first_line=2)
     if values.shape[0] == 0:
         raise TakeError(f"{path}: take has no frames")
@@ -108,6 +114,8 @@ def read(path: str | os.PathLike) -> Take:
         raise TakeError(f"{path}:{bad + 2}: tracking states must be 0, 1 or 2")
     take = _make(path, skeleton, block[..., :3], states.astype(np.uint8), values[:, 0],
                  float(header.get("rate", 30.0)), header.get("metadata", {}))
+    if warnings_:
+        take.metadata["warnings"] = warnings_
     return take
 
 

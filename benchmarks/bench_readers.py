@@ -13,10 +13,11 @@ from pathlib import Path
 
 import numpy as np
 
+import _common  # noqa: F401 (puts the repository on sys.path)
 from kinect_retarget.takes import bvh, kinect_v2_csv, kinectron_json, krtake, msrc12, ntu_skeleton, utkinect
 from tests.takes import format_fixtures as fx
 
-DATA = Path(__file__).resolve().parents[3] / "shared" / "data"
+DATA = _common.SHARED_DATA
 N = 10_000
 
 
