@@ -365,6 +365,7 @@ def status() -> dict:
     return {"state": "recording" if c.recording else "running", "message": c.message,
             "error": src.error, "stats": c.session.statistics(), "tracked": c.session.last_tracked_joints,
             "joints": len(src.skeleton), "calibrating": c.session.calibrating,
+            "device": getattr(src, "device_status", None),
             "recording": c.recording["path"] if c.recording else None}
 
 

@@ -7,12 +7,13 @@ piece of work; until one is importable, this source refuses to start with a sent
 from __future__ import annotations
 
 import importlib
+import time
 
 from .base import FrameSource, SourceError
 
 # Where a tracker may provide `open_skeleton_producer()`; first importable one wins. Relative to the package,
 # which is `bl_ext.<repo>.kinect_retarget` when installed as an extension.
-PRODUCER_MODULES = (".tracking", ".device.skeleton")
+PRODUCER_MODULES = (".depth.producer", ".tracking", ".device.skeleton")
 _ROOT = __package__.rpartition(".")[0]
 
 
@@ -43,6 +44,7 @@ def usb_status() -> str:
 
 class UsbKinectSource(FrameSource):
     kind = "usb"
+    NO_FRAME_TIMEOUT = 5.0  # seconds without a depth frame (unplugged, no device) before live gives up
 
     def __init__(self, producer=None, factory=None):
         self._producer = producer
@@ -80,8 +82,16 @@ class UsbKinectSource(FrameSource):
             except Exception:
                 pass  # closing an unplugged device may fail; the thread is gone either way
 
+    @property
+    def device_status(self) -> str | None:
+        """The depth stream's own sentence (connecting, streaming, unplugged...), when the producer has one."""
+        stream = getattr(self._producer, "stream", None)
+        status = getattr(stream, "status", None)
+        return getattr(status, "message", None)
+
     def _run(self) -> None:
         n = 0
+        last = time.monotonic()
         while not self.stopping:
             try:
                 frame = self._producer.read(0.1)
@@ -90,7 +100,11 @@ class UsbKinectSource(FrameSource):
             except Exception as exc:
                 raise SourceError(f"USB Kinect stopped delivering frames ({exc})") from None
             if frame is None:
+                if time.monotonic() - last > self.NO_FRAME_TIMEOUT:
+                    why = self.device_status or "no frames"
+                    raise SourceError(f"USB Kinect: no depth frame for {self.NO_FRAME_TIMEOUT:.0f} s ({why})")
                 continue
+            last = time.monotonic()
             positions, states, time_s = frame
             self._emit(positions, states, time_s, where=f" frame {n}")
             n += 1

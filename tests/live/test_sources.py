@@ -172,7 +172,10 @@ def test_osc_socket_error_on_the_thread_stops_with_error():
 
 
 # -- USB -----------------------------------------------------------------------------------------------
-def test_usb_without_tracker_refuses_with_a_sentence():
+def test_usb_without_tracker_refuses_with_a_sentence(monkeypatch):
+    from kinect_retarget.sources import usb
+    monkeypatch.setattr(usb, "PRODUCER_MODULES", (".no_such_tracker",))
+    assert "no depth-to-skeleton tracker" in usb.usb_status()
     src = UsbKinectSource(factory=None)
     with pytest.raises(SourceError, match="tracker"):
         src.start(FrameQueue())
@@ -222,3 +225,21 @@ def test_source_rejects_nan_for_tracked_joints(rng):
     assert wait_until(lambda: src.status == "error")
     src.stop()
     assert "NaN" in src.error and "HandLeft" in src.error
+
+
+def test_usb_finds_the_depth_tracker_and_times_out_without_frames(monkeypatch):
+    from kinect_retarget.sources import usb
+    factory, reason = usb.find_skeleton_producer()
+    assert factory is not None and factory.__module__.endswith("depth.producer"), reason
+
+    class Silent(FakeProducer):
+        class stream:
+            class status:
+                message = "Kinect unplugged: waiting for it to come back"
+
+    monkeypatch.setattr(UsbKinectSource, "NO_FRAME_TIMEOUT", 0.3)
+    src = UsbKinectSource(factory=lambda: Silent([]))
+    src.start(FrameQueue())
+    assert wait_until(lambda: src.status == "error")
+    src.stop()
+    assert "no depth frame" in src.error and "unplugged" in src.error
