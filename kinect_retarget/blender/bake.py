@@ -33,7 +33,7 @@ def _write_curves(channelbag, data_path: str, group: str, frames: np.ndarray, va
         co[:, 1] = values[:, c]
         kp.foreach_set("co", co.ravel())
         kp.foreach_set("interpolation", interp)
-        fc.update()
+        kp.handles_recalc()  # keys are written in order and unique: no sort needed, only handles
 
 
 def bake_motion(obj: bpy.types.Object, motion: BakedMotion, action_name: str,
