@@ -175,7 +175,7 @@ def run_job(job: Job, out: Path, args: argparse.Namespace, rigify_base: str | No
 
     from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
     from kinect_retarget.blender.body_mesh import add_body_mesh
-    from kinect_retarget.blender.render import contact_sheet, stage_and_render
+    from kinect_retarget.blender.render import contact_sheet, render_still, stage
 
     result = Outcome(job)
     take = read_take(job)
@@ -200,16 +200,16 @@ def run_job(job: Job, out: Path, args: argparse.Namespace, rigify_base: str | No
     result.bones, result.preset = len(baked.motion.bone_names), baked.preset
     body = add_body_mesh(obj)
     scene = bpy.context.scene
-    if not args.no_render:
-        t1 = time.perf_counter()
-        frames = still_frames(*baked.frame_range, args.stills)
-        note = f"{name} - {RIGS[job.rig]}"
-        with quiet_stdout():
-            result.stills = stage_and_render(scene, [body], frames, str(out / "renders"), stem, note,
-                                             args.resolution)
+    t1 = time.perf_counter()
+    frames = still_frames(*baked.frame_range, args.stills)
+    with quiet_stdout():
+        stage(scene, [body], frames, f"{name} - {RIGS[job.rig]}", args.resolution)
+        if not args.no_render:
+            renders = out / "renders"
+            result.stills = [render_still(scene, str(renders / f"{stem}_f{f:04d}.png"), f) for f in frames]
             if len(result.stills) > 1:
-                result.sheet = contact_sheet(result.stills, str(out / "renders" / f"{stem}_sheet.png"))
-        result.render_s = time.perf_counter() - t1
+                result.sheet = contact_sheet(result.stills, str(renders / f"{stem}_sheet.png"))
+    result.render_s = time.perf_counter() - t1
     scene.frame_set(baked.frame_range[0])
     scene.render.filepath = f"//renders/{stem}_anim_"  # Render Animation in the saved file writes beside it
     result.blend = str(out / f"{stem}.blend")
@@ -247,7 +247,7 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(args.out).resolve()
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
-    log(f"kinect_retarget demo: {len(jobs)} bakes into {os.path.relpath(out)}/")
+    log(f"kinect_retarget demo: {len(jobs)} bake{'s' * (len(jobs) != 1)} into {os.path.relpath(out)}/")
     with quiet_stdout():
         import bpy  # noqa: F401  (first import prints Blender's start-up lines)
     rigify_base = None
@@ -276,8 +276,9 @@ def main(argv: list[str] | None = None) -> int:
             outcome = Outcome(job, error=f"{type(exc).__name__}: {exc}")
             log(f"  failed unexpectedly: {outcome.error}")
         else:
-            log(f"  {outcome.frames} frames, {outcome.bones} bones ({outcome.preset}) in {outcome.bake_s:.2f} s; "
-                f"{len(outcome.stills)} stills in {outcome.render_s:.2f} s")
+            stills = f"; {len(outcome.stills)} stills in {outcome.render_s:.2f} s" if outcome.stills else ""
+            log(f"  {outcome.frames} frames, {outcome.bones} bones ({outcome.preset}) in {outcome.bake_s:.2f} s"
+                + stills)
         outcomes.append(outcome)
     print_summary(outcomes, out, time.perf_counter() - start)
     return 1 if any(o.error for o in outcomes) else 0

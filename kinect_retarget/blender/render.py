@@ -154,15 +154,20 @@ def render_still(scene: bpy.types.Scene, filepath: str, frame: int | None = None
     return path
 
 
-def stage_and_render(scene: bpy.types.Scene, meshes, frames, directory: str, stem: str,
-                     note: str | None = None, resolution: tuple[int, int] = (640, 480),
-                     azimuth_deg: float = 0.0) -> list[str]:
-    """Workbench setup, a floor and a camera framing `meshes` over `frames`, then one PNG per frame
-    named <stem>_f<frame>.png in `directory`. Returns the paths."""
+def stage(scene: bpy.types.Scene, meshes, frames, note: str | None = None,
+          resolution: tuple[int, int] = (640, 480), azimuth_deg: float = 0.0) -> None:
+    """Workbench settings, a floor, and a camera framing `meshes` over `frames`: ready to render."""
     setup_workbench(scene, resolution, note)
     lo, hi = evaluated_bounds(meshes, frames)
     add_floor(scene, lo, hi)
     frame_camera(scene, lo, hi, azimuth_deg=azimuth_deg)
+
+
+def stage_and_render(scene: bpy.types.Scene, meshes, frames, directory: str, stem: str,
+                     note: str | None = None, resolution: tuple[int, int] = (640, 480),
+                     azimuth_deg: float = 0.0) -> list[str]:
+    """stage(), then one PNG per frame named <stem>_f<frame>.png in `directory`. Returns the paths."""
+    stage(scene, meshes, frames, note, resolution, azimuth_deg)
     return [render_still(scene, os.path.join(directory, f"{stem}_f{int(f):04d}.png"), f) for f in frames]
 
 
