@@ -263,3 +263,43 @@ def test_live_on_rigify_reaches_the_desired_pose(registered, rigify_rig_path):
         moving.append(np.median(error()))
     live.stop_live(bake=False)
     assert np.median(moving) < 2.0  # degrees: one frame of lag on what the MCH bones take from elsewhere
+
+
+def test_mapping_table_save_load_and_disabled_rows_drive_nothing(scene_with_rig, tmp_path):
+    scene, obj, take, _ = scene_with_rig
+    s = scene.kinect_retarget
+    s.preset = "kinect"
+    assert bpy.ops.kinect_retarget.mapping_from_preset() == {"FINISHED"}
+    assert len(s.mapping) == len(obj.data.bones)
+    row = next(r for r in s.mapping if r.bone == "ElbowLeft")
+    row.enabled = False
+    path = str(tmp_path / "map.json")
+    assert bpy.ops.kinect_retarget.mapping_save(filepath=path) == {"FINISHED"}
+    bpy.ops.kinect_retarget.mapping_clear()
+    assert len(s.mapping) == 0
+    assert bpy.ops.kinect_retarget.mapping_load(filepath=path) == {"FINISHED"}
+    assert {r.bone: (r.joint, r.enabled) for r in s.mapping}["ElbowLeft"] == ("", False)
+    c = live.start_live(bpy.context, use_timer=False)
+    assert "ElbowLeft" not in c.session.pipeline.bone_names and "ElbowRight" in c.session.pipeline.bone_names
+    live.stop_live(bake=False)
+    bad = tmp_path / "bad.json"
+    bad.write_text("[1, 2")
+    with pytest.raises(RuntimeError, match="cannot read bone mapping"):  # the ERROR report, file named
+        bpy.ops.kinect_retarget.mapping_load(filepath=str(bad))
+    assert len(s.mapping) == len(obj.data.bones)  # the table is untouched
+
+
+def test_start_live_operator_reports_a_missing_take_and_leaves_nothing_running(scene_with_rig, tmp_path):
+    scene, obj, take, _ = scene_with_rig
+    scene.kinect_retarget.take_path = str(tmp_path / "gone.krtake")
+    with pytest.raises(RuntimeError, match="does not exist"):  # bpy.ops raises the operator's ERROR report
+        bpy.ops.kinect_retarget.live_start()
+    assert live.controller() is None and "does not exist" in live.status()["error"]
+    assert not bpy.app.timers.is_registered(live._timer)
+
+
+def test_sidebar_tab_and_preferences_are_registered(registered):
+    assert bpy.types.KINECT_RETARGET_PT_main.bl_category == "Kinect"
+    assert bpy.types.KINECT_RETARGET_PT_main.bl_space_type == "VIEW_3D"
+    from kinect_retarget.blender.preferences import ADDON_ID, KinectRetargetPreferences
+    assert KinectRetargetPreferences.bl_idname == ADDON_ID == "kinect_retarget"
