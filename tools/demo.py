@@ -2,7 +2,7 @@
 .blend per take and rig, render a few Workbench stills of each with a simple body mesh, print a summary.
 
     .venv/bin/python tools/demo.py --out demo_output [--takes A.krtake ...] [--all] [--no-rigify]
-        [--no-render] [--stills 3] [--rigify-frames 150] [--resolution 640x480]
+        [--no-render] [--stills 3] [--rigify-frames 90] [--resolution 640x480] [--docs-images docs/images]
 
 Everything runs headless in one process (bpy as a module). The Rigify rig is generated once from Blender's
 human metarig (rigify_generate) and reopened for each Rigify take; baking onto it is slow (Blender evaluates
@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
+import shutil
 import sys
 import tempfile
 import time
@@ -33,6 +34,12 @@ GENERATED_TAKES = ("kinect_v2_ges01_wavehand", "kinect_v2_ges04_comehere", "kine
                    "kinect_v2_kinectron_recorded_skeleton", "kinect_v1_cmu_131_03_hop",
                    "kinect_v1_cmu_01_01_jumps", "kinect_v1_cmu_131_01_walk")
 RIGIFY_TAKES = ("kinect_v2_ges01_wavehand", "kinect_v1_cmu_131_03_hop")
+# contact sheets copied into docs/images by --docs-images: (take, rig) -> file name
+DOCS_IMAGES = {("kinect_v2_ges01_wavehand", "kinect"): "demo_wavehand_kinect_rig.png",
+               ("kinect_v2_ges06_chickenwing", "kinect"): "demo_chickenwing_kinect_rig.png",
+               ("kinect_v1_cmu_131_03_hop", "kinect"): "demo_cmu_hop_kinect_rig.png",
+               ("kinect_v2_ges01_wavehand", "rigify"): "demo_wavehand_rigify.png"}
+DOCS_IMAGE_LIMIT = 100_000  # bytes: keep the repository light
 RIGIFY_FRAMES = 90  # 3 s of each take: Rigify bakes evaluate the rig frame by frame (slow)
 RIGS = {"kinect": "generated Kinect rig", "rigify": "Rigify rig (human metarig)"}
 
@@ -100,6 +107,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--no-render", action="store_true", help="bake and save only")
     parser.add_argument("--stills", type=int, default=3, help="stills rendered per take and rig (default 3)")
     parser.add_argument("--resolution", default="640x480", help="still size WxH (default 640x480)")
+    parser.add_argument("--docs-images", type=Path, metavar="DIR",
+                        help="also copy the contact sheets used by docs/demo.md into DIR (e.g. docs/images)")
     args = parser.parse_args(argv)
     try:
         w, h = (int(v) for v in args.resolution.lower().split("x"))
@@ -219,6 +228,21 @@ def run_job(job: Job, out: Path, args: argparse.Namespace, rigify_base: str | No
     return result
 
 
+def copy_docs_images(outcomes: list[Outcome], directory: Path) -> None:
+    directory.mkdir(parents=True, exist_ok=True)
+    for o in outcomes:
+        target = DOCS_IMAGES.get((o.name, o.job.rig))
+        if not target or not o.sheet:
+            continue
+        size = os.path.getsize(o.sheet)
+        if size > DOCS_IMAGE_LIMIT:
+            log(f"  not copied to {directory}: {os.path.basename(o.sheet)} is {size // 1000} KB "
+                f"(limit {DOCS_IMAGE_LIMIT // 1000} KB)")
+            continue
+        shutil.copyfile(o.sheet, directory / target)
+        log(f"docs image:   {os.path.relpath(directory / target)} ({size // 1000} KB)")
+
+
 def print_summary(outcomes: list[Outcome], out: Path, elapsed: float) -> None:
     log("")
     log(f"{'take':40s} {'rig':7s} {'frames':>6s} {'bones':>5s} {'bake s':>7s} {'render s':>8s}  output")
@@ -281,6 +305,8 @@ def main(argv: list[str] | None = None) -> int:
                 + stills)
         outcomes.append(outcome)
     print_summary(outcomes, out, time.perf_counter() - start)
+    if args.docs_images:
+        copy_docs_images(outcomes, args.docs_images)
     return 1 if any(o.error for o in outcomes) else 0
 
 

@@ -1,6 +1,10 @@
 """Demo pieces with the real bpy wheel: the capsule body bound to a baked rig, and one Workbench still."""
 from __future__ import annotations
 
+import importlib.util
+import sys
+from pathlib import Path
+
 import bpy
 import numpy as np
 import pytest
@@ -134,3 +138,34 @@ def test_capsule_sizes_follow_the_body():
                                                          "KneeLeft", "AnkleLeft", "HandLeft")}
     assert r["SpineMid"] > r["Head"] > r["Neck"]
     assert r["KneeLeft"] > r["AnkleLeft"] and r["ElbowLeft"] > r["WristLeft"] >= r["HandLeft"]
+
+
+def _demo_module():
+    path = Path(__file__).resolve().parents[2] / "tools" / "demo.py"
+    spec = importlib.util.spec_from_file_location("kr_demo_tool", path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up there
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_demo_tool_bakes_saves_and_renders_and_names_a_bad_take(shared_data, tmp_path, capsys):
+    demo = _demo_module()
+    bad = tmp_path / "broken.csv"
+    bad.write_text("not,a,take\n")
+    take = shared_data / "mocap_bvh" / "131_03.bvh"
+    status = demo.main(["--out", str(tmp_path / "out"), "--takes", str(bad), str(take), "--no-rigify",
+                        "--stills", "2", "--resolution", "160x120"])
+    printed = capsys.readouterr().out
+    assert status == 1                                     # one take failed ...
+    assert "broken.csv" in printed and "unknown take format" in printed
+    assert "1 of 2 bakes done" in printed                  # ... and the other still baked
+    out = tmp_path / "out"
+    assert (out / "131_03__kinect.blend").stat().st_size > 0
+    stills = sorted((out / "renders").glob("131_03__kinect_f*.png"))
+    assert len(stills) == 2 and (out / "renders" / "131_03__kinect_sheet.png").is_file()
+    bpy.ops.wm.open_mainfile(filepath=str(out / "131_03__kinect.blend"))
+    rig = bpy.data.objects["KinectRig"]
+    assert rig.animation_data.action is not None and rig.animation_data.action_slot is not None
+    assert bpy.context.scene.camera is not None
+    assert [o for o in bpy.data.objects if o.get("kinect_retarget_body") == "KinectRig"]
