@@ -2,10 +2,9 @@
 
 Each joint is the centroid of an iso-geodesic ring around a limb (or the trunk), at a fixed fraction of the
 body's geodesic length; the fractions are human proportions, measured on MakeHuman's base mesh and checked
-on its posed versions (benchmarks/bench_autorig.py). Joints inside the torso
-(hips, shoulder line) come from lines fitted to the limb centre lines, which is the automatic form of the
-paper's shoulder/ankle adjustment (§4.2): instead of stepping a point by hand, it is moved onto the axis of
-the limb it belongs to.
+on its posed versions (benchmarks/bench_autorig.py). The paper's hand-stepped shoulder/ankle adjustment
+(§4.2) becomes automatic: the shoulder is moved onto the upper arm's axis; the hips are placed from the
+pelvis's cross-section rather than from the tilted thigh rings.
 """
 from __future__ import annotations
 
@@ -18,6 +17,7 @@ from .features import FeaturePoints
 # surface barely stretches when a body moves, so these hold from A-pose to T-pose to a split (the branch
 # lengths of the tree metric do not: the junctions slide with the arms).
 ARM = {"WristLeft": 0.110, "ElbowLeft": 0.222, "ShoulderLeft": 0.335}
+UPPER_ARM = (0.25, 0.32)  # arm rings that give the upper arm's axis (shoulder adjustment, §4.2)
 HAND_AT = (0.047, 0.5)   # the palm: half-way from the wrist to the ring across the finger roots
 LEG = {"FootLeft": 0.085, "AnkleLeft": 0.125, "KneeLeft": 0.31}
 PELVIS_AT = 0.44         # head field: a cross-section of the pelvis just above the crotch
@@ -37,6 +37,11 @@ def ring_centroid(vertices: np.ndarray, field: np.ndarray, g: float, width: floa
             return vertices[band].mean(axis=0)
     near = np.argmin(np.abs(field - g) + (0 if mask is None else np.where(mask, 0, np.inf)))
     return vertices[near].copy()
+
+
+def _axis(points: np.ndarray) -> np.ndarray:
+    """Unit direction of the line best fitting the points."""
+    return np.linalg.svd(points - points.mean(axis=0))[2][0]
 
 
 def _cross_section_axis(vertices, field, g, width, mask, normal) -> np.ndarray:
@@ -68,6 +73,12 @@ def kinect_joints(vertices: np.ndarray, fp: FeaturePoints, segment: np.ndarray, 
         f = fp.distances[s_hand]
         for name, t in ARM.items():
             out[idx(name.replace("Left", side))] = ring_centroid(vertices, f, t * size, width)
+        # §4.2, automatically: the ring at the shoulder wraps the armpit and the deltoid, so its centroid
+        # sits low and inward; the joint is put back on the upper arm's axis at the same distance.
+        shoulder, elbow = out[idx("Shoulder" + side)], out[idx("Elbow" + side)]
+        axis = _axis(np.array([ring_centroid(vertices, f, t * size, width) for t in np.linspace(*UPPER_ARM, 5)]))
+        axis *= np.sign(axis @ (shoulder - elbow)) or 1.0
+        out[idx("Shoulder" + side)] = elbow + axis * np.linalg.norm(shoulder - elbow)
         wrist = out[idx("Wrist" + side)]
         palm = ring_centroid(vertices, f, HAND_AT[0] * size, width)
         out[idx("Hand" + side)] = wrist + HAND_AT[1] * (palm - wrist)
