@@ -145,3 +145,37 @@ def test_cli_bake_and_info(shared_data, tmp_path):
     bad = subprocess.run([sys.executable, "-m", "kinect_retarget", "info", str(tmp_path / "missing.csv")],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "missing.csv" in bad.stderr
+
+
+def test_rigify_metarig_preset(bpy_empty, shared_data):
+    import addon_utils
+    from kinect_retarget.blender.bake_take import bake_take
+    bpy = bpy_empty
+    addon_utils.enable("rigify", default_set=True)
+    bpy.ops.object.armature_human_metarig_add()
+    obj = bpy.context.object
+    take = load_take(shared_data / "mocap_bvh" / "01_01.bvh").slice(slice(0, 480, 4))
+    res = bake_take(obj, take, preset="auto", settings=RetargetSettings(filter="none"))
+    assert res.preset == "rigify-metarig" and res.motion.root_bone == "spine"
+    pairs = {f"{b}.{s[0]}": (f"{a}{s}", f"{c}{s}") for s in ("Left", "Right") for b, a, c in
+             (("upper_arm", "Shoulder", "Elbow"), ("forearm", "Elbow", "Wrist"), ("thigh", "Hip", "Knee"),
+              ("shin", "Knee", "Ankle"), ("foot", "Ankle", "Foot"))}
+    errs = _check_directions(bpy, obj, res.motion, take, pairs, every=5)
+    assert errs.max() < 0.5
+
+
+def test_cli_mapping_override_unmaps_bones(shared_data, tmp_path):
+    import json
+    mapping = tmp_path / "map.json"
+    mapping.write_text(json.dumps({"ElbowLeft": "", "WristLeft": None}))
+    out = tmp_path / "wave.blend"
+    take = shared_data / "kinect_v2" / "Ges01_wavehand.csv"
+    r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(take), "--out", str(out),
+                        "--mapping", str(mapping)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert '"bones": 23' in r.stdout  # 25 Kinect v2 bones less the two unmapped ones
+    bad = tmp_path / "bad.json"
+    bad.write_text("[1, 2]")
+    r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(take), "--out", str(out),
+                        "--mapping", str(bad)], capture_output=True, text=True)
+    assert r.returncode == 2 and "bad.json" in r.stderr

@@ -75,3 +75,42 @@ def test_bake_onto_makehuman_skeleton(bpy_empty, shared_data):
     # root motion scaled by n = MakeHuman leg / performer leg
     assert res.motion.root_bone == "root"
     assert np.isfinite(res.motion.root_location).all()
+
+
+# The same real skeleton under other naming conventions: each preset's table must drive its rig.
+RENAMES = {
+    "mixamo": {"root": "mixamorig:Hips", "spine04": "mixamorig:Spine", "spine02": "mixamorig:Spine2",
+               "neck01": "mixamorig:Neck", "head": "mixamorig:Head",
+               **{f"{mh}.{s}": f"mixamorig:{side}{mx}" for s, side in (("L", "Left"), ("R", "Right"))
+                  for mh, mx in (("clavicle", "Shoulder"), ("upperarm01", "Arm"), ("lowerarm01", "ForeArm"),
+                                 ("wrist", "Hand"), ("upperleg01", "UpLeg"), ("lowerleg01", "Leg"),
+                                 ("foot", "Foot"))}},
+    "hanim": {"root": "sacroiliac", "spine04": "vl5", "spine02": "vt1", "neck01": "vc4", "head": "skullbase",
+              **{f"{mh}.{s}": f"{s.lower()}_{ha}" for s in ("L", "R")
+                 for mh, ha in (("clavicle", "sternoclavicular"), ("upperarm01", "shoulder"),
+                                ("lowerarm01", "elbow"), ("wrist", "wrist"), ("upperleg01", "hip"),
+                                ("lowerleg01", "knee"), ("foot", "ankle"))}},
+}
+
+
+@pytest.mark.parametrize("preset", sorted(RENAMES))
+def test_presets_drive_renamed_skeleton(bpy_empty, shared_data, preset):
+    from kinect_retarget.blender.bake_take import bake_take
+    bpy = bpy_empty
+    obj = build_makehuman_armature(bpy, shared_data)
+    for old, new in RENAMES[preset].items():
+        obj.data.bones[old].name = new
+    take = load_take(shared_data / "kinect_v2" / "Ges03_drawlines.csv")
+    res = bake_take(obj, take, preset="auto", settings=RetargetSettings(filter="none"))
+    assert res.preset == preset
+    upper = RENAMES[preset]["upperarm01.R"]
+    src = kinect_to_blender(take.positions[res.motion.samples])
+    sk = take.skeleton
+    errs = []
+    for i in range(0, len(res.motion.frames), 10):
+        bpy.context.scene.frame_set(int(res.motion.frames[i]))
+        pb = obj.pose.bones[upper]
+        d = np.array(pb.tail - pb.head)
+        s = src[i, sk.index("ElbowRight")] - src[i, sk.index("ShoulderRight")]
+        errs.append(np.degrees(np.arccos(np.clip(d @ s / np.linalg.norm(d) / np.linalg.norm(s), -1, 1))))
+    assert np.max(errs) < 0.5
