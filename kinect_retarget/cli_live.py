@@ -6,8 +6,6 @@ import contextlib
 import json
 import os
 import sys
-import time
-
 import numpy as np
 
 # Typical adult segment lengths (m) for a generated rig when no take gives real ones (OSC, USB sources).
@@ -72,72 +70,22 @@ def run_live(args) -> int:
         from .core.presets import load_mapping_file
         overrides = load_mapping_file(args.mapping)
 
-    with stdout_to_stderr():
-        result = _run_in_blender(args, source, overrides)
-    print(json.dumps(result))
-    if result["error"]:
-        print(f"error: live stopped: {result['error']}", file=sys.stderr)
-        return 1
-    return 0
-
-
-def _run_in_blender(args, source, overrides) -> dict:
-    import bpy
-
-    from . import register, unregister
-    from .sources import SourceError
-    from .blender import live
-    from .blender.headless import find_armature
-    from .blender.kinect_rig import build_kinect_rig
-    from .blender.mapping_ui import fill_table
-
-    if args.rig:
-        if not os.path.isfile(args.rig):
-            raise ValueError(f"{args.rig}: rig file not found")
-        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(args.rig), load_ui=False)
-        register()
-        obj = find_armature(args.armature)
-        preset = args.preset
-    else:
-        bpy.ops.wm.read_factory_settings(use_empty=True)
-        register()
+    lengths = None
+    if not args.rig:  # bone lengths of the generated rig: the take's, or typical ones for live devices
         take = getattr(source, "take", None)
         if take is not None:
             from .core.kinect_rig_layout import median_segment_lengths
             lengths = median_segment_lengths(take)
         else:
             lengths = typical_lengths(source.skeleton)
-        obj = build_kinect_rig(bpy.context.scene, source.skeleton, lengths, "KinectRig")
-        preset = "kinect" if args.preset == "auto" else args.preset
-    try:
-        bpy.context.view_layer.objects.active = obj
-        s = bpy.context.scene.kinect_retarget
-        s.initialised = True
-        s.armature, s.preset, s.filter, s.root, s.mirror = obj, preset, args.filter, args.root, args.mirror
-        s.play_on_record = False
-        if overrides:
-            fill_table(s, overrides)
-        try:
-            c = live.start_live(bpy.context, source=source, use_timer=False)
-        except SourceError as exc:
-            raise ValueError(str(exc)) from None
-        if args.record:
-            c.start_recording(bpy.context, os.path.abspath(args.record))
-        start = time.perf_counter()
-        while time.perf_counter() - start < args.seconds and live.pump_live():
-            time.sleep(0.002)
-        elapsed = time.perf_counter() - start
-        stats = c.session.statistics()
-        live.stop_live(bake=bool(args.record))
-        stats = c.session.statistics()  # final: includes frames drained while stopping
-        result = {"source": args.source, "seconds": round(elapsed, 3), "armature": obj.name, **stats,
-                  "error": c.session.error, "record": os.path.abspath(args.record) if args.record else None,
-                  "action": c.baked_action}
-        if args.out:
-            os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
-            bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(args.out), check_existing=False)
-            result["out"] = os.path.abspath(args.out)
-    finally:
-        live.stop_live(bake=False)
-        unregister()
-    return result
+    with stdout_to_stderr():
+        from .blender.live import run_headless
+        result = run_headless(source, args.seconds, rig_path=args.rig, armature=args.armature,
+                              preset=args.preset, filter_name=args.filter, root=args.root, mirror=args.mirror,
+                              overrides=overrides, record=args.record, out=args.out, rig_lengths=lengths)
+        result = {"source": args.source, **result}
+    print(json.dumps(result))
+    if result["error"]:
+        print(f"error: live stopped: {result['error']}", file=sys.stderr)
+        return 1
+    return 0

@@ -369,6 +369,63 @@ def status() -> dict:
             "recording": c.recording["path"] if c.recording else None}
 
 
+def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset="auto",
+                 filter_name="default", root="xyz", mirror=False, overrides=None, record=None, out=None,
+                 rig_lengths=None) -> dict:
+    """The `live` command: open the rig (or build the generated one with `rig_lengths`), run the pump loop
+    for `seconds` (or until the source ends), bake the recording, save `out`. Returns the statistics."""
+    from .. import register, unregister
+    from .headless import find_armature
+    from .kinect_rig import build_kinect_rig
+    from .mapping_ui import fill_table
+
+    if rig_path:
+        if not os.path.isfile(rig_path):
+            raise ValueError(f"{rig_path}: rig file not found")
+        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(rig_path), load_ui=False)
+        register()
+        try:
+            obj = find_armature(armature)
+        except ValueError:
+            unregister()
+            raise
+    else:
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        register()
+        obj = build_kinect_rig(bpy.context.scene, source.skeleton, rig_lengths, "KinectRig")
+        preset = "kinect" if preset == "auto" else preset
+    try:
+        bpy.context.view_layer.objects.active = obj
+        s = bpy.context.scene.kinect_retarget
+        s.initialised = True
+        s.armature, s.preset, s.filter, s.root, s.mirror = obj, preset, filter_name, root, mirror
+        s.play_on_record = False
+        if overrides:
+            fill_table(s, overrides)
+        try:
+            c = start_live(bpy.context, source=source, use_timer=False)
+        except SourceError as exc:
+            raise ValueError(str(exc)) from None
+        if record:
+            c.start_recording(bpy.context, os.path.abspath(record))
+        start = time.perf_counter()
+        while time.perf_counter() - start < seconds and pump_live():
+            time.sleep(0.002)
+        elapsed = time.perf_counter() - start
+        stop_live(bake=bool(record))
+        result = {"seconds": round(elapsed, 3), "armature": obj.name, **c.session.statistics(),
+                  "error": c.session.error, "record": os.path.abspath(record) if record else None,
+                  "action": c.baked_action}
+        if out:
+            os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
+            bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out), check_existing=False)
+            result["out"] = os.path.abspath(out)
+    finally:
+        stop_live(bake=False)
+        unregister()
+    return result
+
+
 # -- operators -----------------------------------------------------------------------------------------------
 def _flush_reports(op) -> None:
     c = _controller

@@ -64,8 +64,19 @@ def test_live_osc_receives_ni_mate_frames_and_stops_on_garbage(tmp_path):
     idx = {n: take.skeleton.index(j) for n, j in names.items()}
     stop = threading.Event()
 
+    def listening() -> bool:
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+            try:
+                probe.bind(("127.0.0.1", port))
+            except OSError:
+                return True  # the live command holds the port
+        return False
+
     def sender():
-        time.sleep(2.0)  # Blender start-up
+        end = time.perf_counter() + 60
+        while not listening() and not stop.is_set() and time.perf_counter() < end:
+            time.sleep(0.2)  # Blender start-up
+        time.sleep(0.2)
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
             for i in range(40):
                 if stop.is_set():
