@@ -148,9 +148,10 @@ class Retargeter:
             child, p = b, int(rig.parents[b])
             while p >= 0 and p not in slot:
                 chain = rig.rest[p, :3, :3].T @ rig.rest[child, :3, :3] @ chain
-                if not rig.inherit_rotation[p]:
+                child = p
+                if not rig.inherit_rotation[p]:  # p keeps its rest orientation: the chain starts there
                     break
-                child, p = p, int(rig.parents[p])
+                p = int(rig.parents[p])
             if p >= 0 and p in slot:
                 self.anchor[k] = slot[p]
                 self.static[k] = rig.rest[p, :3, :3].T @ rig.rest[child, :3, :3] @ chain

@@ -190,3 +190,27 @@ def test_wrong_armature_is_a_clear_error(hop):
     rig = TargetRig("Chair", ("Leg", "Seat"), [-1, 0], np.tile(np.eye(4), (2, 1, 1)), [1.0, 1.0])
     with pytest.raises(ValueError, match="no bone of armature 'Chair' is mapped"):
         RetargetPipeline(KINECT_V1, rig, generated_mapping(KINECT_V1))
+
+
+def test_unmapped_bones_and_inherit_rotation_flags(hop):
+    """Unmapped bones in the chain stay at rest; bones that do not inherit rotation are solved too."""
+    rig = generated_rig(KINECT_V1, median_segment_lengths(hop))
+    mapping = generated_mapping(KINECT_V1)
+    del mapping["ElbowLeft"]  # the upper arm stays at rest between shoulder and forearm
+    inherit = np.ones(len(rig.bone_names), bool)
+    inherit[KINECT_V1.index("ShoulderRight")] = False   # a mapped bone that ignores its parent's rotation
+    inherit[KINECT_V1.index("ElbowLeft")] = False       # an unmapped one in the middle of a chain
+    rig = TargetRig("Flags", rig.bone_names, rig.parents, rig.rest, rig.lengths, inherit_rotation=inherit)
+    pipe = RetargetPipeline(KINECT_V1, rig, mapping, RetargetSettings(filter="none"))
+    motion = pipe.process_take(hop)
+    posed = evaluate_pose(rig, pipe.retargeter.bone_indices, motion.quats)
+    p = kinect_to_blender(hop.positions[motion.samples])
+    for m in pipe.retargeter.mapped:
+        if m.is_root:
+            continue
+        src = normalize(p[:, m.tail] - p[:, m.head])
+        err = np.degrees(np.arccos(np.clip(np.sum(src * posed[:, m.index, :3, 1], -1), -1, 1)))
+        assert err.max() < 1e-3, m.bone
+    elbow = KINECT_V1.index("ElbowLeft")
+    np.testing.assert_allclose(posed[:, elbow, :3, :3], np.broadcast_to(rig.rest[elbow, :3, :3], (len(posed), 3, 3)),
+                               atol=1e-12)
