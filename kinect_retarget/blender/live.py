@@ -231,12 +231,15 @@ def _constrained_bones(obj) -> set[str]:
 
 
 def _save_state(obj) -> dict:
+    """What live changes on the rig, by name (undo during live invalidates bpy references)."""
     ad = obj.animation_data
+    action = ad.action if ad else None
     state = {"pose": snapshot_pose(obj),
              "ik_fk": {n: obj.pose.bones[n]["IK_FK"] for n in RIGIFY_FK_SWITCHES
                        if n in obj.pose.bones and "IK_FK" in obj.pose.bones[n]},
-             "action": ad.action if ad else None, "slot": ad.action_slot if ad else None}
-    if ad is not None and ad.action is not None:
+             "action": action.name if action else None,
+             "slot": ad.action_slot.identifier if action is not None and ad.action_slot else None}
+    if action is not None:
         ad.action = None  # an assigned action would overwrite the live pose on every evaluation
     return state
 
@@ -245,17 +248,18 @@ def _restore_state(obj, state: dict, keep_animation: bool) -> None:
     for name, value in state["ik_fk"].items():
         if name in obj.pose.bones:
             obj.pose.bones[name]["IK_FK"] = value
+    action = bpy.data.actions.get(state["action"]) if state["action"] else None
     if keep_animation:  # the baked recording now animates the rig
+        if action is not None and action.users == 0:
+            action.use_fake_user = True  # the rig's previous action must not vanish on the next save
         return
     restore_pose(obj, state["pose"])
-    if state["action"] is not None:
+    if action is not None:
         ad = obj.animation_data or obj.animation_data_create()
-        ad.action = state["action"]
-        if state["slot"] is not None:
-            try:
-                ad.action_slot = state["slot"]
-            except (TypeError, RuntimeError, ReferenceError):
-                pass  # slot removed meanwhile: Blender picks one
+        ad.action = action
+        slot = next((sl for sl in action.slots if sl.identifier == state["slot"]), None)
+        if slot is not None:
+            ad.action_slot = slot
 
 
 def _redraw() -> None:

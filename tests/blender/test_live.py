@@ -303,3 +303,23 @@ def test_sidebar_tab_and_preferences_are_registered(registered):
     assert bpy.types.KINECT_RETARGET_PT_main.bl_space_type == "VIEW_3D"
     from kinect_retarget.blender.preferences import ADDON_ID, KinectRetargetPreferences
     assert KinectRetargetPreferences.bl_idname == ADDON_ID == "kinect_retarget"
+
+
+def test_rig_action_is_detached_during_live_and_kept_safe(scene_with_rig):
+    scene, obj, take, _ = scene_with_rig
+    from kinect_retarget.blender.bake_take import bake_take
+    bake_take(obj, take, preset="kinect", action_name="UserAction", set_scene_range=False)
+    user_action = obj.animation_data.action
+    slot = obj.animation_data.action_slot.identifier
+    # stop without recording: the user's action comes back with its slot
+    live.start_live(bpy.context, use_timer=False)
+    assert obj.animation_data.action is None
+    live.pump_live()
+    live.stop_live()
+    assert obj.animation_data.action == user_action and obj.animation_data.action_slot.identifier == slot
+    # a baked recording replaces it, and the previous action survives a save (fake user)
+    c = live.start_live(bpy.context, use_timer=False)
+    c.start_recording(bpy.context)
+    run_live()
+    assert obj.animation_data.action.name.startswith("KinectRig_live_")
+    assert bpy.data.actions["UserAction"].use_fake_user
