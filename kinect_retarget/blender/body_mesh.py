@@ -19,7 +19,9 @@ SIDES = tuple(SIDE_COLOURS)
 
 # Bones that are detail rather than body (Rigify face and fingers, Mixamo fingers...): no capsule.
 _DETAIL = re.compile(r"(^|[^a-z])(f_|thumb|palm|finger|index|middle|ring|pinky|lip|lid|brow|cheek|nose|ear|"
-                     r"jaw|chin|tongue|teeth|eye|forehead|temple|breast|special|oris|levator|risorius|orbicularis|temporalis)", re.IGNORECASE)
+                     r"jaw|chin|tongue|teeth|eye|forehead|temple|breast|"
+                     r"special|oris|levator|risorius|orbicularis|temporalis)",  # MakeHuman face bones
+                     re.IGNORECASE)
 _BODY_PARTS = (  # (pattern on the bone name, capsule radius as a fraction of the character's height)
     (re.compile(r"head|skull|spine\.006", re.I), 0.055),
     (re.compile(r"neck|spine\.00[45]|vc4", re.I), 0.030),
@@ -37,10 +39,11 @@ MIN_BONE_FRACTION = 0.025  # bones shorter than this fraction of the height are 
 
 
 def rest_height(armature: bpy.types.Object) -> float:
-    """Vertical extent of the rest skeleton (armature space), at least 0.1 so tiny rigs still get a body."""
+    """The character's size: the largest extent of its rest skeleton in armature space (its height, or its
+    arm span in a T-pose, about the same), whichever axis is up (FBX rigs are often Y-up inside)."""
     heads, tails = _rest_points(armature.data.bones)
-    z = np.concatenate([heads[:, 2], tails[:, 2]])
-    return max(float(z.max() - z.min()), 0.1) if z.size else 1.0
+    points = np.concatenate([heads, tails])
+    return max(float(np.ptp(points, axis=0).max()), 1e-3) if len(points) else 1.0
 
 
 def body_bones(armature: bpy.types.Object) -> list[str]:
