@@ -471,6 +471,8 @@ class KINECT_RETARGET_OT_live_start(bpy.types.Operator):
     def invoke(self, context, event):
         if self.execute(context) != {"FINISHED"}:
             return {"CANCELLED"}
+        if context.window is None:  # no window (background): the timer alone drives live
+            return {"FINISHED"}
         wm = context.window_manager
         self._timer = wm.event_timer_add(0.1, window=context.window)
         wm.modal_handler_add(self)

@@ -323,3 +323,42 @@ def test_rig_action_is_detached_during_live_and_kept_safe(scene_with_rig):
     run_live()
     assert obj.animation_data.action.name.startswith("KinectRig_live_")
     assert bpy.data.actions["UserAction"].use_fake_user
+
+
+@pytest.mark.parametrize("fault, expect", [("garbage", "bad OSC packet"), ("socket", "socket error")])
+def test_osc_faults_reach_the_panel_status(scene_with_rig, fault, expect):
+    import socket
+
+    from kinect_retarget.sources import OscReceiver
+    from kinect_retarget.sources.osc_codec import encode_message
+
+    scene, obj, take, _ = scene_with_rig
+    src = OscReceiver(port=0)
+    c = live.start_live(bpy.context, source=src, use_timer=False)
+    c.start_recording(bpy.context)
+    rec_path = c.recording["path"]
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        for i in range(3):
+            for j, name in enumerate(take.skeleton.joints):
+                s.sendto(encode_message("/" + name, *map(float, take.positions[i, j])), ("127.0.0.1", src.port))
+            s.sendto(encode_message("/NI_mate_sync", "x"), ("127.0.0.1", src.port))
+        time.sleep(0.2)
+        live.pump_live()
+        if fault == "garbage":
+            s.sendto(b"\x00\x01not osc", ("127.0.0.1", src.port))
+        else:
+            src._sock.close()
+    run_live(5.0)
+    st = live.status()
+    assert st["state"] == "error" and expect in st["error"]
+    assert krtake.read(rec_path).frame_count == 3
+    assert not [t for t in threading.enumerate() if t.name.startswith("kinect_retarget") and t.is_alive()]
+
+
+def test_invoke_without_a_window_runs_on_the_timer(scene_with_rig):
+    scene, obj, take, _ = scene_with_rig
+    scene.kinect_retarget.loop = True
+    assert bpy.ops.kinect_retarget.live_start("INVOKE_DEFAULT") == {"FINISHED"}
+    assert live.controller() is not None and bpy.app.timers.is_registered(live._timer)
+    assert bpy.ops.kinect_retarget.live_stop() == {"FINISHED"}
+    assert live.controller() is None and not bpy.app.timers.is_registered(live._timer)
