@@ -370,6 +370,7 @@ def status() -> dict:
             "error": src.error, "stats": c.session.statistics(), "tracked": c.session.last_tracked_joints,
             "joints": len(src.skeleton), "calibrating": c.session.calibrating,
             "device": getattr(src, "device_status", None),
+            "progress": (src.position + 1, src.take.frame_count) if isinstance(src, TakePlayback) else None,
             "recording": c.recording["path"] if c.recording else None}
 
 

@@ -72,6 +72,8 @@ class KINECT_RETARGET_PT_main(_KinectPanel, bpy.types.Panel):
                 p99 = stats["latency_p99_ms"]
                 col.label(text=f"applied {stats['applied']} · dropped {stats['dropped']} · "
                                f"latency p99 {p99 if p99 is not None else '–'} ms")
+            if st.get("progress"):
+                col.label(text="take frame {} / {}".format(*st["progress"]), icon="FILE_MOVIE")
             if st.get("device"):
                 col.label(text=st["device"], icon="OUTLINER_OB_CAMERA")
             if st.get("calibrating"):

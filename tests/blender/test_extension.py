@@ -61,6 +61,7 @@ def test_install_enable_bake_disable_in_the_bpy_extension_repository(extension_z
     assert proc.returncode == 0 and lines, f"child failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
     result = json.loads(lines[-1][7:])
     assert result["installed"] and result["enabled"]
+    assert result["prefs"] == [7000, False, "TAKE"]  # add-on preferences registered under the extension id
     assert result["bake"] == ["FINISHED"] and result["keys"] > 100
     assert result["after_disable"] == {"classes": [], "timers": False, "handlers": [], "threads": []}
     assert result["after_cycles"] == {"classes": [], "timers": False, "handlers": [], "threads": []}
@@ -116,6 +117,8 @@ def _child(zip_path: str, take_path: str) -> None:
     out["installed"] = os.path.isfile(os.path.join(bpy.utils.user_resource("EXTENSIONS"), "user_default",
                                                    "kinect_retarget", "blender_manifest.toml"))
     out["enabled"] = EXT in bpy.context.preferences.addons
+    prefs = bpy.context.preferences.addons[EXT].preferences
+    out["prefs"] = [prefs.osc_port, prefs.osc_listen_all, prefs.default_source]
     pkg = importlib.import_module(EXT)
     rig_mod = importlib.import_module(EXT + ".blender.kinect_rig")
     layout = importlib.import_module(EXT + ".core.kinect_rig_layout")

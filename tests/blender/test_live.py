@@ -119,6 +119,9 @@ def test_stop_without_recording_restores_the_pose(scene_with_rig):
         live.pump_live()
         time.sleep(0.005)
     assert not np.allclose(pose_quats(obj, [b.name for b in obj.pose.bones]), before, atol=1e-4)
+    st = live.status()  # what the panel draws
+    assert st["state"] == "running" and st["progress"][1] == take.frame_count and st["joints"] == 25
+    assert st["tracked"] > 0 and st["stats"]["applied"] > 0
     bpy.ops.kinect_retarget.live_stop()
     assert live.controller() is None
     np.testing.assert_allclose(pose_quats(obj, [b.name for b in obj.pose.bones]), before, atol=1e-6)
