@@ -147,7 +147,10 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     head = max(heady, key=lambda e: e[1] @ up, default=None)
     # the head top pins the torso along its axis (the torso patch alone drifts along the body)
     if head is not None:
-        anchored = head[1] - axis * (1.0 - calib.torso_patch_height) * H
+        # the geodesic extremum lies anywhere on the skull; the top is the highest point near it
+        near = xyz[mask & (np.linalg.norm(xyz - head[1], axis=-1) < 0.15)]
+        top = near[np.argmax(near @ axis)] if len(near) else head[1]
+        anchored = top - axis * (1.0 - calib.torso_patch_height) * H
         shift = (anchored - centre) @ axis
         if abs(shift) > 0.15:  # not the head (a shoulder or raised hand): the torso cannot move that far
             head = None
