@@ -81,10 +81,26 @@ def fetch_wheel(filename: str, cache: Path) -> Path:
     return target
 
 
+def package_files() -> list[Path]:
+    """The package's files: those git tracks (no scratch files or caches), or the whole tree outside git."""
+    try:
+        proc = subprocess.run(["git", "ls-files", "-z", "--", PACKAGE.name], cwd=REPO, capture_output=True,
+                              text=True, check=True)
+        files = [REPO / f for f in proc.stdout.split("\0") if f]
+    except (OSError, subprocess.CalledProcessError):
+        files = []
+    if not files:
+        files = [p for p in PACKAGE.rglob("*") if p.is_file()]
+    return [f for f in files if f.is_file() and "__pycache__" not in f.parts and not f.name.endswith(".pyc")
+            and not f.name.startswith(".")]
+
+
 def stage(manifest: dict, staging: Path) -> None:
     shutil.copy2(MANIFEST, staging / "blender_manifest.toml")
-    shutil.copytree(PACKAGE, staging, dirs_exist_ok=True,
-                    ignore=shutil.ignore_patterns("__pycache__", "*.pyc", ".*"))
+    for f in package_files():
+        target = staging / f.relative_to(PACKAGE)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(f, target)
     wheels = staging / "wheels"
     wheels.mkdir()
     cache = wheel_cache()
