@@ -153,9 +153,18 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
         anchored = top - axis * (1.0 - calib.torso_patch_height) * H
         shift = (anchored - centre) @ axis
         if abs(shift) > 0.15:  # not the head (a shoulder or raised hand): the torso cannot move that far
-            head = None
-        else:
-            centre = centre + axis * shift
+            head, shift = None, None
+    else:
+        shift = None
+    # the tops of the shoulders pin it better (the neck bends forward while walking; the shoulders stay)
+    sc_a = (bm.HEIGHT_SHOULDER_CENTER - calib.torso_patch_height) * H
+    top_a = _shoulder_top(xyz, mask, centre, axis, lat, H, sc_a + (shift or 0.0))
+    if top_a is not None:
+        s_shift = top_a + bm.SHOULDER_TOP_BELOW_CENTRE * H - sc_a
+        if abs(s_shift) < 0.2 and (shift is None or abs(s_shift - shift) < 0.15):
+            shift = s_shift
+    if shift is not None:
+        centre = centre + axis * shift
     def along(h_frac: float) -> np.ndarray:
         return centre + axis * (h_frac - calib.torso_patch_height) * H
 
@@ -233,6 +242,22 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
             st[J[f"{mid}{s}"]] = TRACKED if mid_ok or st_limb == TRACKED else INFERRED
             st[J[f"{end}{s}"]] = st[J[f"{tip}{s}"]] = st_limb
     return FitResult(pos, st, lat, labels, centre, None if head is None else head[1])
+
+
+def _shoulder_top(xyz, mask, centre, axis, lat, H, expect):
+    """Height along the torso axis (relative to `centre`) of the tops of the shoulders: the high points
+    just beside the neck. The higher side, unless the sides disagree (a raised arm), then the lower."""
+    pts = xyz[mask]
+    rel = pts - centre
+    a, l = rel @ axis, rel @ lat
+    tops = []
+    for sign in (1.0, -1.0):
+        sel = (sign * l > 0.07 * H) & (sign * l < 0.11 * H) & (a > expect - 0.3) & (a < expect + 0.2)
+        if sel.sum() >= 3:
+            tops.append(float(np.percentile(a[sel], 90)))
+    if not tops:
+        return None
+    return min(tops) if len(tops) == 2 and abs(tops[0] - tops[1]) > 0.08 else max(tops)
 
 
 def _hanging_arm(xyz, mask, shoulder, axis, lat, sign, centre, H):
