@@ -18,12 +18,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from .conventions import KINECT_TO_BLENDER
-from .joint_frames import ALIASES, frame_from_y_hint, resolver, segment_hint
+from .joint_frames import ALIASES, frame_from_y_hint, resolver, role_and_side, segment_hint
 from .quat import conjugate, from_matrix, mul, rotate
 from .skeletons import Skeleton
 from .target_rig import TargetRig
 
 ROOT_MODES = ("xyz", "xy", "none")
+AXIAL_ROLES = ("pelvis", "spine", "chest", "neck", "head")  # segments that point up on any rest humanoid
+COS_ALONG_SEGMENT = 0.5  # an axial bone more than 60° off vertical at rest is a control, not a segment
 
 
 @dataclass(frozen=True)
@@ -70,14 +72,24 @@ def resolve_mapping(skeleton: Skeleton, rig: TargetRig, mapping: dict[str, str])
     return out
 
 
-def target_joint_positions(skeleton: Skeleton, rig: TargetRig, mapped: list[MappedBone]) -> np.ndarray:
+def is_axial_control(m: MappedBone, rig: TargetRig, up: np.ndarray) -> bool:
+    """A spine/neck/head bone that does not lie along its segment at rest (Rigify's torso and chest
+    controls rest horizontal): its head and tail are not joint positions."""
+    axial = m.is_root or role_and_side(m.tail_name)[0] in AXIAL_ROLES
+    return axial and float(rig.rest[m.index, :3, 1] @ up) < COS_ALONG_SEGMENT
+
+
+def target_joint_positions(skeleton: Skeleton, rig: TargetRig, mapped: list[MappedBone],
+                           up: np.ndarray) -> np.ndarray:
     """Estimated rest positions of the source joints on the target (armature space), NaN where unknown.
-    Tails of mapped bones first, heads fill the rest (a thigh's head is the hip joint)."""
+    Tails of mapped bones first, heads fill the rest (a thigh's head is the hip joint); control bones that
+    do not lie along their segment say nothing about joints."""
     pos = np.full((len(skeleton), 3), np.nan)
-    for m in mapped:
+    usable = [m for m in mapped if not is_axial_control(m, rig, up)]
+    for m in usable:
         if not m.is_root:
             pos[m.tail] = rig.tails[m.index]
-    for m in mapped:
+    for m in usable:
         if np.isnan(pos[m.head, 0]):
             pos[m.head] = rig.heads[m.index]
     return pos
@@ -117,13 +129,17 @@ class Retargeter:
         # the character's own left and up in armature space, for hints when a joint is missing
         self.world_lateral = rig.object_rotation.T @ np.array([1.0, 0.0, 0.0])
         self.world_up = rig.object_rotation.T @ np.array([0.0, 0.0, 1.0])
-        tpos = target_joint_positions(skeleton, rig, self.mapped)
+        tpos = target_joint_positions(skeleton, rig, self.mapped, self.world_up)
         get_t = _drop_unknown(resolver(skeleton.joints, tpos))
         self.target_leg = leg_length(get_t)
         # constant per bone: C_b = O_tᵀ · R_rest(b)
         self.constants = np.empty((len(self.mapped), 3, 3))
         for k, m in enumerate(self.mapped):
             y = rig.rest[m.index, :3, 1]
+            if is_axial_control(m, rig, self.world_up):
+                # the segment such a control drives points up in the rest pose (paper §2.2), whatever the
+                # bone's own axis; the control turns with it rigidly
+                y = self.world_up
             hint = segment_hint(get_t, m.tail_name, y, self.world_lateral, self.world_up)
             o_t = frame_from_y_hint(y, np.nan_to_num(hint))
             self.constants[k] = o_t.T @ rig.rest[m.index, :3, :3]

@@ -86,6 +86,9 @@ def test_rigify_generated_rig_limbs_follow(shared_data, rigify_rig_path):
               ("shin", "Knee", "Ankle"))}
     errs = _check_directions(bpy, obj, res.motion, take, pairs, every=3)
     assert errs.mean() < 2.0
+    # the trunk follows the performer's spine too (Rigify's torso/chest controls rest horizontal)
+    spine = {"DEF-spine.001": ("SpineBase", "SpineMid"), "DEF-spine.003": ("SpineMid", "SpineShoulder")}
+    assert _check_directions(bpy, obj, res.motion, take, spine, every=3).max() < 10.0
     # switched to FK in the action, rig structure untouched
     assert obj.pose.bones["upper_arm_parent.L"]["IK_FK"] == pytest.approx(1.0)
     bpy.ops.wm.read_factory_settings(use_empty=True)
