@@ -23,3 +23,4 @@ def viterbi(unary: np.ndarray, pairwise: np.ndarray) -> np.ndarray:
     for t in range(f - 1, 0, -1):
         path[t - 1] = back[t, path[t]]
     return path
+
