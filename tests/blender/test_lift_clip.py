@@ -122,3 +122,58 @@ def test_cli_lifts_a_blend_with_a_clip(bpy_empty, tmp_path, walk_2d):
     take = load_take(out)
     assert take.frame_count == len(uv)
     assert take.metadata.get("focal_known") is True
+
+
+# H-Anim humanoid bones (named after the H-Anim joint at their head) as the 'hanim' preset expects them:
+# bone -> (head joint, tail joint, parent bone); "Head+" is 10 cm above the head joint.
+HANIM_BONES = {
+    "sacroiliac": ("HipCenter", "Spine", None), "vl5": ("Spine", "ShoulderCenter", "sacroiliac"),
+    "vt1": ("ShoulderCenter", "Neck", "vl5"), "skullbase": ("Neck", "Head+", "vt1"),
+    **{f"{s}_{bone}": (f"{a}{side}", f"{b}{side}", par.format(s=s)) for s, side in (("l", "Left"), ("r", "Right"))
+       for bone, a, b, par in (("sternoclavicular", "Shoulder", "Shoulder", "vl5"),
+                               ("shoulder", "Shoulder", "Elbow", "{s}_sternoclavicular"),
+                               ("elbow", "Elbow", "Wrist", "{s}_shoulder"), ("wrist", "Wrist", "Hand", "{s}_elbow"),
+                               ("hip", "Hip", "Knee", "sacroiliac"), ("knee", "Knee", "Ankle", "{s}_hip"),
+                               ("ankle", "Ankle", "Foot", "{s}_knee"))},
+}
+
+
+def _hanim_rig(bpy, rest_kinect: np.ndarray):
+    """An H-Anim armature in the CMU T-pose (01_01 frame 0), Blender axes."""
+    p = {n: kinect_to_blender(rest_kinect[KINECT_V1.index(n)] - rest_kinect[0]) for n in KINECT_V1.joints}
+    p["Neck"] = 0.5 * (p["ShoulderCenter"] + p["Head"])
+    p["Head+"] = p["Head"] + np.array([0.0, 0.0, 0.1])
+    arm = bpy.data.armatures.new("HAnim")
+    obj = bpy.data.objects.new("HAnim", arm)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    bpy.ops.object.mode_set(mode="EDIT")
+    for name, (head, tail, _) in HANIM_BONES.items():
+        b = arm.edit_bones.new(name)
+        # the sternoclavicular bone runs from the neck base to the shoulder
+        b.head = p["ShoulderCenter"] if name.endswith("sternoclavicular") else p[head]
+        b.tail = p[tail]
+    for name, (_, _, parent) in HANIM_BONES.items():
+        if parent:
+            arm.edit_bones[name].parent = arm.edit_bones[parent]
+    bpy.ops.object.mode_set(mode="OBJECT")
+    return obj
+
+
+def test_lift_bakes_onto_an_hanim_humanoid(bpy_empty, tmp_path, walk_2d, shared_data):
+    from kinect_retarget.blender.lift_op import lift_clip_and_bake
+    bpy = bpy_empty
+    pos, uv = walk_2d
+    clip = _clip(bpy, tmp_path, uv)
+    rest = bvh.read(shared_data / "mocap_bvh" / "01_01.bvh").positions[0]
+    rig = _hanim_rig(bpy, rest)
+    out = lift_clip_and_bake(bpy.context, clip, rig.name, preset="auto")
+    assert out.preset == "hanim"
+    scene = bpy.context.scene
+    for frame in (10, 40):
+        scene.frame_set(frame)
+        for bone, (a, b) in (("l_knee", ("KneeLeft", "AnkleLeft")), ("r_shoulder", ("ShoulderRight", "ElbowRight"))):
+            pb = rig.pose.bones[bone]
+            got = np.array(rig.matrix_world @ pb.tail) - np.array(rig.matrix_world @ pb.head)
+            real = kinect_to_blender(pos[frame - 1, KINECT_V1.index(b)] - pos[frame - 1, KINECT_V1.index(a)])
+            assert got @ real / np.linalg.norm(got) / np.linalg.norm(real) > np.cos(np.radians(30)), bone
