@@ -212,7 +212,11 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
                 end_p = (tip_p if end_p is None else end_p + inside(end))
                 mid_ls = level_set_centroid(xyz, de, d_end + l2, band(0.06), end_p, l2 + 0.1)
                 labels.append((f"{tip}{s}", e[1]))
-                st_limb = TRACKED
+                # a true hand/foot lies a limb's length along the surface beyond its shoulder/hip; an
+                # elbow sticking out (hand on the face) or a knee is nearer: keep the guess, flag it
+                root_cell = _nearest_cell(xyz, mask, a)
+                along_limb = e[2] - (d0[root_cell] if root_cell is not None and np.isfinite(d0[root_cell]) else 0.0)
+                st_limb = TRACKED if along_limb > 0.7 * (l1 + l2) else INFERRED
             else:
                 found_arm = _hanging_arm(xyz, mask, a, axis, lat, 1.0 if s == "Left" else -1.0, centre, H) \
                     if root == "Shoulder" else None
