@@ -24,24 +24,11 @@ from kinect_retarget.autorig.geodesic import dijkstra  # noqa: E402
 from kinect_retarget.autorig.graph import mesh_graph  # noqa: E402
 from kinect_retarget.autorig.inside import inside_mesh  # noqa: E402
 from kinect_retarget.autorig.levels import reeb_baseline  # noqa: E402
-from kinect_retarget.autorig.mesh import Mesh  # noqa: E402
+from kinect_retarget.autorig.mesh import Mesh, subdivide  # noqa: E402
 from kinect_retarget.core.skeletons import KINECT_V1  # noqa: E402
 from kinect_retarget.takes.bvh import read_bvh_skeleton  # noqa: E402
 
 TOLERANCE = 3.0  # % of body height
-
-
-def subdivide(mesh: Mesh) -> Mesh:
-    """Split every triangle into four (edge midpoints shared): a denser copy of the same surface."""
-    f = mesh.faces
-    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
-    uniq, inv = np.unique(e, axis=0, return_inverse=True)
-    mid = len(mesh.vertices) + inv.reshape(3, -1).T  # (T, 3) midpoints of edges 01, 12, 20
-    verts = np.concatenate([mesh.vertices, mesh.vertices[uniq].mean(axis=1)])
-    a, b, c = f.T
-    ab, bc, ca = mid.T
-    faces = np.concatenate([np.stack(x, 1) for x in ((a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca))])
-    return Mesh(verts, faces, mesh.name + "-x4")
 
 
 def row(label: str, err: np.ndarray, extra: str = "") -> str:

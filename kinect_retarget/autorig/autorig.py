@@ -95,7 +95,7 @@ def autorig(mesh: Mesh, levels: int = LEVELS) -> AutoRig:
     up_coord = v @ fp.up
     height = float(up_coord.max() - up_coord.min())
     paper = paper_skeleton(v, bgraph, fp.distances, levels)
-    joints = kinect_joints(v, fp, segment, height)
+    joints = kinect_joints(v, body_mesh.faces, fp, segment, height)
     if not np.all(np.isfinite(joints)):
         raise MeshError(f"{mesh.name}: joint placement failed (non-finite positions)")
     timings["joints"] = time.perf_counter() - t0

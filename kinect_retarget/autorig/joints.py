@@ -16,25 +16,38 @@ from .features import FeaturePoints
 # Ring positions as fractions of the body's geodesic length L (head top to feet, along the surface). The
 # surface barely stretches when a body moves, so these hold from A-pose to T-pose to a split (the branch
 # lengths of the tree metric do not: the junctions slide with the arms).
-ARM = {"WristLeft": 0.110, "ElbowLeft": 0.222, "ShoulderLeft": 0.335}
+ARM = {"WristLeft": 0.105, "ElbowLeft": 0.215, "ShoulderLeft": 0.335}
 UPPER_ARM = (0.25, 0.32)  # arm rings that give the upper arm's axis (shoulder adjustment, §4.2)
 HAND_AT = (0.047, 0.5)   # the palm: half-way from the wrist to the ring across the finger roots
-LEG = {"FootLeft": 0.085, "AnkleLeft": 0.125, "KneeLeft": 0.31}
+LEG = {"FootLeft": 0.075, "AnkleLeft": 0.125, "KneeLeft": 0.31}
 PELVIS_AT = 0.44         # head field: a cross-section of the pelvis just above the crotch
-HIP_HALF_WIDTH = 0.058   # hip joints: this far to each side of the hip centre
-TORSO = {"ShoulderCenter": 0.193, "Spine": 0.36, "HipCenter": 0.48}  # head field, inside the trunk
+HIP_HALF_WIDTH = 0.056   # hip joints: this far to each side of the hip centre
+HIP_DROP = 0.01          # ... and this far below it along the trunk
+TORSO = {"ShoulderCenter": 0.19, "HipCenter": 0.48}  # head field, inside the trunk
+SPINE_AT = 0.42          # Spine: this far from the hip centre to the shoulder centre (a trunk ring
+                         # there is pulled toward the belly)
 HEAD_DOWN = 0.30         # Head joint: this far from the top toward the neck base
 
 
+def vertex_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """A third of the area of each triangle around each vertex: centroids weighted by it do not drift
+    toward the finely meshed side of a ring (faces, hands and seams are often denser)."""
+    t = vertices[faces]
+    area = 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
+    return np.bincount(faces.ravel(), np.repeat(area / 3, 3), len(vertices))
+
+
 def ring_centroid(vertices: np.ndarray, field: np.ndarray, g: float, width: float,
-                  mask: np.ndarray | None = None) -> np.ndarray:
-    """Centroid of the vertices whose geodesic value is within `width` of g (widened until non-empty)."""
+                  mask: np.ndarray | None = None, area: np.ndarray | None = None) -> np.ndarray:
+    """Area-weighted centroid of the vertices whose geodesic value is within `width` of g (the band is
+    widened until it holds vertices)."""
     for w in (width, 2 * width, 4 * width, 8 * width):
         band = np.abs(field - g) < w
         if mask is not None:
             band &= mask
         if band.any():
-            return vertices[band].mean(axis=0)
+            wt = None if area is None else area[band] + 1e-30
+            return np.average(vertices[band], axis=0, weights=wt)
     near = np.argmin(np.abs(field - g) + (0 if mask is None else np.where(mask, 0, np.inf)))
     return vertices[near].copy()
 
@@ -44,15 +57,16 @@ def _axis(points: np.ndarray) -> np.ndarray:
     return np.linalg.svd(points - points.mean(axis=0))[2][0]
 
 
-def _cross_section_axis(vertices, field, g, width, mask, normal) -> np.ndarray:
-    """Unit long axis of the ring at g, in the plane normal to `normal` (principal component)."""
+def _cross_section_axis(vertices, field, g, width, mask, normal, area) -> np.ndarray:
+    """Unit long axis of the ring at g, in the plane normal to `normal` (area-weighted principal axis)."""
     for w in (width, 2 * width, 4 * width):
         band = (np.abs(field - g) < w) & mask
         if band.sum() >= 3:
             break
-    p = vertices[band] - vertices[band].mean(axis=0)
+    wt = area[band] + 1e-30
+    p = vertices[band] - np.average(vertices[band], axis=0, weights=wt)
     p -= np.outer(p @ normal, normal)
-    return np.linalg.eigh(p.T @ p)[1][:, -1]
+    return np.linalg.eigh((p * wt[:, None]).T @ p)[1][:, -1]
 
 
 def body_length(fp: FeaturePoints) -> float:
@@ -60,8 +74,14 @@ def body_length(fp: FeaturePoints) -> float:
     return float(fp.distances[0, fp.vertices[3:5]].mean())
 
 
-def kinect_joints(vertices: np.ndarray, fp: FeaturePoints, segment: np.ndarray, height: float) -> np.ndarray:
+def kinect_joints(vertices: np.ndarray, faces: np.ndarray, fp: FeaturePoints, segment: np.ndarray,
+                  height: float) -> np.ndarray:
     """(20, 3) joint positions in KINECT_V1 order, in mesh coordinates."""
+    area = vertex_areas(vertices, faces)
+
+    def ring(field, g, mask=None):
+        return ring_centroid(vertices, field, g, width, mask, area)
+
     out = np.zeros((len(KINECT_V1), 3))
     idx = KINECT_V1.index
     size = body_length(fp)
@@ -72,22 +92,23 @@ def kinect_joints(vertices: np.ndarray, fp: FeaturePoints, segment: np.ndarray, 
     for side, s_hand, s_foot in (("Left", 1, 3), ("Right", 2, 4)):
         f = fp.distances[s_hand]
         for name, t in ARM.items():
-            out[idx(name.replace("Left", side))] = ring_centroid(vertices, f, t * size, width)
+            out[idx(name.replace("Left", side))] = ring(f, t * size)
         # §4.2, automatically: the ring at the shoulder wraps the armpit and the deltoid, so its centroid
         # sits low and inward; the joint is put back on the upper arm's axis at the same distance.
         shoulder, elbow = out[idx("Shoulder" + side)], out[idx("Elbow" + side)]
-        axis = _axis(np.array([ring_centroid(vertices, f, t * size, width) for t in np.linspace(*UPPER_ARM, 5)]))
+        axis = _axis(np.array([ring(f, t * size) for t in np.linspace(*UPPER_ARM, 5)]))
         axis *= np.sign(axis @ (shoulder - elbow)) or 1.0
         out[idx("Shoulder" + side)] = elbow + axis * np.linalg.norm(shoulder - elbow)
         wrist = out[idx("Wrist" + side)]
-        palm = ring_centroid(vertices, f, HAND_AT[0] * size, width)
+        palm = ring(f, HAND_AT[0] * size)
         out[idx("Hand" + side)] = wrist + HAND_AT[1] * (palm - wrist)
         f = fp.distances[s_foot]
         for name, t in LEG.items():
-            out[idx(name.replace("Left", side))] = ring_centroid(vertices, f, t * size, width)
+            out[idx(name.replace("Left", side))] = ring(f, t * size)
     for name, t in TORSO.items():
-        out[idx(name)] = ring_centroid(vertices, head_f, t * size, width, in_trunk)
+        out[idx(name)] = ring(head_f, t * size, in_trunk)
 
+    out[idx("Spine")] = out[idx("HipCenter")] + SPINE_AT * (out[idx("ShoulderCenter")] - out[idx("HipCenter")])
     top = vertices[fp.vertices[0]]
     neck = out[idx("ShoulderCenter")]
     head = top + HEAD_DOWN * (neck - top)
@@ -98,14 +119,15 @@ def kinect_joints(vertices: np.ndarray, fp: FeaturePoints, segment: np.ndarray, 
         depth = vertices[slab] @ fp.front
         head += fp.front * ((depth.min() + depth.max()) / 2 - head @ fp.front)
     out[idx("Head")] = head
-    # Hips: level with the hip centre, half a pelvis width to each side along the pelvis's own left-right
+    # Hips: just below the hip centre, half a pelvis width to each side along the pelvis's own left-right
     # axis (the long axis of the trunk's cross-section just above the crotch). The thighs' own rings do
     # not give it: a flexed or spread leg drags them forward, back or outward.
     hip_centre = out[idx("HipCenter")]
     trunk = neck - hip_centre
     trunk /= max(np.linalg.norm(trunk), 1e-12)
-    lateral = _cross_section_axis(vertices, head_f, PELVIS_AT * size, 3 * width, in_trunk, trunk)
+    lateral = _cross_section_axis(vertices, head_f, PELVIS_AT * size, 6 * width, in_trunk, trunk, area)
     lateral *= np.sign(lateral @ fp.left) or 1.0
-    out[idx("HipLeft")] = hip_centre + HIP_HALF_WIDTH * size * lateral
-    out[idx("HipRight")] = hip_centre - HIP_HALF_WIDTH * size * lateral
+    below = hip_centre - HIP_DROP * size * trunk
+    out[idx("HipLeft")] = below + HIP_HALF_WIDTH * size * lateral
+    out[idx("HipRight")] = below - HIP_HALF_WIDTH * size * lateral
     return out

@@ -47,6 +47,21 @@ class Mesh:
         return Mesh(self.vertices[used], inverse.reshape(-1, 3), name or self.name), used
 
 
+def subdivide(mesh: Mesh, face_mask: np.ndarray | None = None) -> Mesh:
+    """Split the chosen triangles (all by default) into four at their edge midpoints. Splitting only some
+    leaves T-junctions and uneven triangle sizes, which is how some real meshes come."""
+    chosen = np.ones(len(mesh.faces), bool) if face_mask is None else np.asarray(face_mask, bool)
+    f = mesh.faces[chosen]
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    uniq, inv = np.unique(e, axis=0, return_inverse=True)
+    mid = len(mesh.vertices) + inv.reshape(3, -1).T  # (T, 3) midpoints of edges 01, 12, 20
+    verts = np.concatenate([mesh.vertices, mesh.vertices[uniq].mean(axis=1)])
+    a, b, c = f.T
+    ab, bc, ca = mid.T
+    new = [np.stack(x, 1) for x in ((a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca))]
+    return Mesh(verts, np.concatenate([mesh.faces[~chosen]] + new), mesh.name + "-subdivided")
+
+
 def triangulate(polygons: list[list[int]]) -> np.ndarray:
     """Fan-triangulate polygons given as vertex-index lists (vectorised per polygon size)."""
     out = []
