@@ -129,7 +129,7 @@ class PersonMask:
 
 
 def find_people(grid: DepthGrid, floor: FloorPlane | None, gravity: np.ndarray | None,
-                max_jump: float = 0.12) -> list[PersonMask]:
+                max_jump: float = 0.2) -> list[PersonMask]:
     """Person-like connected components above the floor, largest first."""
     fg = grid.valid.copy()
     if floor is not None:
