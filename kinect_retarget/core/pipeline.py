@@ -59,6 +59,7 @@ class FramePose:
     root_bone: str | None
     root_location: np.ndarray  # (3,)
     time: float
+    desired: np.ndarray | None = None  # (M, 4) armature-space rotations, for rigs with constrained parents
 
 
 class RetargetPipeline:
@@ -122,14 +123,22 @@ class RetargetPipeline:
 
     def process_frame(self, positions: np.ndarray, states: np.ndarray, time: float) -> FramePose | None:
         """One live frame; None when no joint is tracked (nothing to apply, filter untouched)."""
-        states = np.asarray(states)
+        return self.process_frames(np.asarray(positions)[None], np.asarray(states)[None], np.array([time]))
+
+    def process_frames(self, positions: np.ndarray, states: np.ndarray, times: np.ndarray) -> FramePose | None:
+        """Several live frames that arrived together: every one goes through the filter (so live equals the
+        bake), only the newest is solved. (K, J, 3), (K, J), (K,) -> pose of the last tracked frame or None."""
         positions = np.asarray(positions, dtype=np.float64)
-        if not np.any(states != NOT_TRACKED):
+        states, times = np.asarray(states), np.asarray(times, dtype=np.float64)
+        keep = np.flatnonzero(np.any(states != NOT_TRACKED, axis=1))
+        if keep.size == 0:
             return None
+        positions, states, times = positions[keep], states[keep], times[keep]
         if not np.all(np.isfinite(positions[states != NOT_TRACKED])):
             raise ValueError("frame has NaN or infinite positions for tracked joints")
-        p = self._filtered(positions[None], states[None], np.array([time]))[0]
+        p = self._filtered(positions, states, times)
         if self.root_reference is None:
-            self.root_reference = p[self.skeleton.root].copy()
-        quats, location = self.retargeter.solve(p[None], self.root_reference, self.source_leg)
-        return FramePose(self.bone_names, quats[0], self.root_bone, location[0], float(time))
+            self.root_reference = p[0, self.skeleton.root].copy()
+        quats, location, desired = self.retargeter.solve(p[-1:], self.root_reference, self.source_leg,
+                                                         want_desired=True)
+        return FramePose(self.bone_names, quats[0], self.root_bone, location[0], float(times[-1]), desired[0])
