@@ -53,8 +53,8 @@ class SurfaceGraph:
             length = np.linalg.norm(flat_xyz[a0] - flat_xyz[b0], axis=-1)
             ok = real & flat_mask[a0] & flat_mask[b0] & (np.abs(flat_xyz[a0, 2] - flat_xyz[b0, 2]) < max_jump)
             cum = np.concatenate([np.zeros((lines.shape[0], 1)), np.cumsum(np.where(ok, length, CUT), axis=1)], axis=1)
-            valid = lines >= 0
-            self._dirs.append((np.where(valid, lines, 0), valid, cum))
+            # padding points at one spare slot past the grid, which always reads "unreached"
+            self._dirs.append((np.where(lines >= 0, lines, h * w), cum))
 
     def distances(self, sources: np.ndarray, init: np.ndarray | None = None, iterations: int = 12) -> np.ndarray:
         """Geodesic distance (h, w) from the source cells (bool mask or (k, 2) row/col); inf off-surface."""
@@ -64,17 +64,19 @@ class SurfaceGraph:
             d[src & self.mask] = 0.0
         elif src.size:
             d[src[:, 0], src[:, 1]] = 0.0
-        flat = np.where(np.isfinite(d), d, 1e9).ravel()
+        n = d.size
+        flat = np.append(np.where(np.isfinite(d), d, 1e9).ravel(), 1e9)
         for _ in range(iterations):
             before = flat.copy()
-            for lines, valid, cum in self._dirs:
-                v = np.where(valid, flat[lines], 1e9)
+            for lines, cum in self._dirs:
+                v = flat[lines]
                 v = np.minimum(v, cum + np.minimum.accumulate(v - cum, axis=1))
                 v = np.minimum(v, -cum + np.minimum.accumulate((v + cum)[:, ::-1], axis=1)[:, ::-1])
-                flat[lines[valid]] = v[valid]
+                flat[lines] = v
+                flat[n] = 1e9
             if np.array_equal(flat, before):
                 break
-        d = flat.reshape(self.mask.shape)
+        d = flat[:n].reshape(self.mask.shape)
         return np.where((d < CUT * 0.5) & self.mask, d, INF)
 
 
