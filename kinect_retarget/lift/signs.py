@@ -60,6 +60,7 @@ class SignPriors:
     elbow_tolerance: float = 0.05    # sine of the backward bend allowed before it costs
     hand_continues_forearm: float = 2.0
     foot_forward: float = 12.0
+    thigh_adduction: float = 20.0
     foot_tolerance: float = 0.2      # how far forward (cosine) a foot should point before it is free
     wrist_behind_back: float = 4.0
     shoulder_hip_twist: float = 6.0
@@ -146,6 +147,9 @@ def _limb_unary(group: SignGroup, lp: np.ndarray, left: np.ndarray, fwd: np.ndar
         flex = _hinge(upper, lower, left)  # knee flexion bends the shin back: positive about the left axis
         cost = pri.knee_hyperextension * np.maximum(0.0, -flex - pri.knee_tolerance) ** 2 * 10
         cost += pri.foot_forward * np.maximum(0.0, pri.foot_tolerance - np.sum(_unit(tip) * fwd, axis=-1)) ** 2
+        # a thigh can swing far outward but only a little inward: the other leg is in the way
+        outward = np.sum(_unit(upper) * (left if group.name.endswith("Left") else -left), axis=-1)
+        cost = cost + pri.thigh_adduction * np.maximum(0.0, -outward - 0.3) ** 2 * 10
     else:
         flex = _hinge(upper, lower, left)  # elbow flexion brings the forearm forward: negative about left
         cost = pri.elbow_hyperextension * np.maximum(0.0, flex - pri.elbow_tolerance) ** 2 * 10
