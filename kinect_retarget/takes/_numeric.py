@@ -23,6 +23,18 @@ def normalise(data: bytes, delimiters: bytes = b"") -> bytes:
     return data.translate(table)
 
 
+def numeric_first_row(head: bytes, ncol: int, delimiters: bytes = b"") -> list[bytes] | None:
+    """The first line's fields when it holds exactly `ncol` numbers, else None (format detection)."""
+    fields = normalise(head.split(b"\n", 1)[0], delimiters).split()
+    if len(fields) != ncol:
+        return None
+    try:
+        [float(v) for v in fields]
+    except ValueError:
+        return None
+    return fields
+
+
 def field_counts(data: bytes) -> np.ndarray:
     """Number of whitespace-separated fields on each line of `data` (lines split at b'\\n')."""
     buf = np.frombuffer(data, dtype=np.uint8)

@@ -12,20 +12,13 @@ import numpy as np
 
 from ..core.skeletons import KINECT_V1, NOT_TRACKED, TRACKED
 from ..core.take import Take, TakeError, nominal_rate
-from ._numeric import parse_table, read_bytes
+from ._numeric import numeric_first_row, parse_table, read_bytes
 
 NCOL = 1 + 4 * len(KINECT_V1)
 
 
 def looks_like(head: bytes) -> bool:
-    first = head.split(b"\n", 1)[0].replace(b",", b" ").split()
-    if len(first) != NCOL:
-        return False
-    try:
-        [float(v) for v in first]
-    except ValueError:
-        return False
-    return True
+    return numeric_first_row(head, NCOL, b",") is not None
 
 
 def read(path: str | os.PathLike) -> Take:

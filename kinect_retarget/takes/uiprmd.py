@@ -22,7 +22,7 @@ import numpy as np
 
 from ..core.skeletons import KINECT_V2, TRACKED
 from ..core.take import Take, TakeError
-from ._numeric import parse_table, read_bytes
+from ._numeric import numeric_first_row, parse_table, read_bytes
 from .bvh import _axis_rotations
 
 RATE = 30.0
@@ -47,14 +47,7 @@ NCOL = 3 * len(NAMES)
 
 
 def looks_like(head: bytes) -> bool:
-    first = head.split(b"\n", 1)[0].strip().split(b",")
-    if len(first) != NCOL:
-        return False
-    try:
-        [float(v) for v in first]
-    except ValueError:
-        return False
-    return True
+    return numeric_first_row(head, NCOL, b",") is not None
 
 
 def partner_paths(path: str) -> tuple[str, str]:

@@ -11,21 +11,15 @@ import numpy as np
 
 from ..core.skeletons import KINECT_V1, NOT_TRACKED, TRACKED
 from ..core.take import Take, TakeError
-from ._numeric import parse_table, read_bytes
+from ._numeric import numeric_first_row, parse_table, read_bytes
 
 RATE = 30.0
 NCOL = 1 + 3 * len(KINECT_V1)
 
 
 def looks_like(head: bytes) -> bool:
-    first = head.split(b"\n", 1)[0].split()
-    if len(first) != NCOL or not first[0].isdigit():
-        return False
-    try:
-        [float(v) for v in first]
-    except ValueError:
-        return False
-    return True
+    first = numeric_first_row(head, NCOL)
+    return first is not None and first[0].isdigit()  # a video frame number, not a timestamp
 
 
 def read(path: str | os.PathLike) -> Take:
