@@ -65,6 +65,16 @@ def test_elbows_and_knees_bend_about_one_axis_without_twist(hop):
         assert bent.any() and np.abs(q[bent, 3]).max() < np.sin(np.radians(2) / 2), lower
 
 
+def _assert_bones_follow(pipe, posed, p, tol_deg=1e-3):
+    """Every mapped non-root bone's armature-space Y axis along its source segment (p in armature space)."""
+    for m in pipe.retargeter.mapped:
+        if m.is_root:
+            continue
+        src = normalize(p[:, m.tail] - p[:, m.head])
+        err = np.degrees(np.arccos(np.clip(np.sum(src * posed[:, m.index, :3, 1], -1), -1, 1)))
+        assert err.max() < tol_deg, m.bone
+
+
 def _a_pose_rig(take, scale=1.3, object_matrix=None):
     """A differently proportioned target in an A-pose with rolled bones, built from generated_rig's layout."""
     lengths = median_segment_lengths(take) * scale
@@ -96,12 +106,7 @@ def test_a_pose_target_with_rolls_and_rotated_object_still_follows_directions(ho
     posed = evaluate_pose(rig, pipe.retargeter.bone_indices, motion.quats, pipe.retargeter.root.index,
                           motion.root_location)
     p = kinect_to_blender(hop.positions[motion.samples]) @ rig.object_rotation
-    for m in pipe.retargeter.mapped:
-        if m.is_root:
-            continue
-        src = normalize(p[:, m.tail] - p[:, m.head])
-        err = np.degrees(np.arccos(np.clip(np.sum(src * posed[:, m.index, :3, 1], -1), -1, 1)))
-        assert err.max() < 1e-3, m.bone
+    _assert_bones_follow(pipe, posed, p)
     # root displacement scaled by n = target leg / source leg (1.3 here), in armature space
     head = posed[:, pipe.retargeter.root.index, :3, 3]
     n = pipe.retargeter.scale_for(pipe.source_leg)
@@ -204,13 +209,7 @@ def test_unmapped_bones_and_inherit_rotation_flags(hop):
     pipe = RetargetPipeline(KINECT_V1, rig, mapping, RetargetSettings(filter="none"))
     motion = pipe.process_take(hop)
     posed = evaluate_pose(rig, pipe.retargeter.bone_indices, motion.quats)
-    p = kinect_to_blender(hop.positions[motion.samples])
-    for m in pipe.retargeter.mapped:
-        if m.is_root:
-            continue
-        src = normalize(p[:, m.tail] - p[:, m.head])
-        err = np.degrees(np.arccos(np.clip(np.sum(src * posed[:, m.index, :3, 1], -1), -1, 1)))
-        assert err.max() < 1e-3, m.bone
+    _assert_bones_follow(pipe, posed, kinect_to_blender(hop.positions[motion.samples]))
     elbow = KINECT_V1.index("ElbowLeft")
     np.testing.assert_allclose(posed[:, elbow, :3, :3], np.broadcast_to(rig.rest[elbow, :3, :3], (len(posed), 3, 3)),
                                atol=1e-12)
