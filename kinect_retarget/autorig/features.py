@@ -10,6 +10,7 @@ from .geodesic import dijkstra
 from .graph import MeshGraph
 from .mesh import MeshError
 
+MAX_ARM_LEG = 0.9  # humans measure 0.65-0.75 (arm and leg branch lengths, any pose we tried)
 CANDIDATES = 8  # farthest points examined; a human needs five, the rest are fingers, hips, ...
 LABELS = ("head", "hand_left", "hand_right", "foot_left", "foot_right")
 
@@ -110,6 +111,11 @@ def find_feature_points(vertices: np.ndarray, graph: MeshGraph) -> FeaturePoints
     if pair[head, feet].min() < 1.05 * pair[head, hands].max():
         raise MeshError(_describe("the four limbs do not split into arms near the head and legs far from "
                                   "it: not a human figure", 5))
+    arm_leg = branch[hands].max() / branch[feet].min()
+    if arm_leg > MAX_ARM_LEG:
+        raise MeshError(_describe(f"the four limbs are about as long as each other (arms/legs {arm_leg:.2f}; "
+                                  f"a human's arms are clearly shorter): a four-legged animal or a piece of "
+                                  f"furniture, not a human figure", 5))
     up = vertices[tips[head]] - vertices[tips[feet]].mean(axis=0)
     up /= np.linalg.norm(up)
     # Toes point forward: the foot tips lie ahead of the shins' centre line.

@@ -16,13 +16,15 @@ def grid_mesh(n: int, rng: np.random.Generator, jitter: float = 0.3):
     return verts, faces
 
 
-def spiky_sphere(directions: np.ndarray, subdivisions: int = 40, spike: float = 3.0):
-    """A UV sphere pulled out into one long spike per direction (a star: not a human)."""
+def spiky_sphere(directions: np.ndarray, subdivisions: int = 40, spike=3.0):
+    """A UV sphere pulled out into one spike per direction (a star: not a human); `spike`: length, one for
+    all or one per direction."""
     th, ph = np.meshgrid(np.linspace(0, np.pi, subdivisions), np.linspace(0, 2 * np.pi, 2 * subdivisions,
                                                                             endpoint=False), indexing="ij")
     unit = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1).reshape(-1, 3)
     d = directions / np.linalg.norm(directions, axis=1, keepdims=True)
-    r = 1 + spike * np.exp(-(np.arccos(np.clip(unit @ d.T, -1, 1)) ** 2) / 0.04).sum(axis=1)
+    lengths = np.broadcast_to(np.asarray(spike, dtype=float), (len(d),))
+    r = 1 + (lengths * np.exp(-(np.arccos(np.clip(unit @ d.T, -1, 1)) ** 2) / 0.04)).sum(axis=1)
     verts = unit * r[:, None]
     rows, cols = subdivisions, 2 * subdivisions
     i, j = np.meshgrid(np.arange(rows - 1), np.arange(cols), indexing="ij")

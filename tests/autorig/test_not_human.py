@@ -22,3 +22,12 @@ def test_plain_sphere_is_not_human():
 def test_no_faces():
     with pytest.raises(MeshError, match="no faces"):
         Mesh(np.zeros((3, 3)), np.zeros((0, 3)), "dots")
+
+
+def test_tailless_quadruped_is_not_human():
+    """Four equal legs and a short head: five branches like a human, but the 'arms' are as long as the legs."""
+    legs = [[1, -1, 0.6], [1, -1, -0.6], [-1, -1, 0.6], [-1, -1, -0.6]]
+    dirs = np.array(legs + [[1.2, 0.8, 0]], float)
+    verts, faces = spiky_sphere(dirs, subdivisions=60, spike=[4, 4, 4, 4, 1.2])
+    with pytest.raises(MeshError, match="four-legged"):
+        autorig(Mesh(verts * [1.6, 1, 1], faces, "dog"))
