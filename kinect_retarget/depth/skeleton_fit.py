@@ -137,7 +137,7 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
         lat = _unit(lat - (lat @ axis) * axis)
     inside = lambda name: view * bm.DEPTH_INSIDE[name]
     # --- extremities ---------------------------------------------------------------------------------
-    extrema = (geodesic_extrema(loose, d0, count=7, min_distance=0.15 * H, iterations=4) if EXTREMA == "plagemann"
+    extrema = (geodesic_extrema(loose, d0, count=6, min_distance=0.15 * H, iterations=4) if EXTREMA == "plagemann"
                else geodesic_maxima(xyz, d0, count=6, min_distance=0.15 * H, window=max(3, int(0.12 / cell) | 1)))
     cand = []
     for r, c, dist in extrema:
