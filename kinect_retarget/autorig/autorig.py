@@ -36,6 +36,7 @@ class AutoRig:
     paper: SkeletonPoints       # the paper's skeleton points (body-local groups)
     height: float
     report: dict = field(default_factory=dict)
+    body_points: np.ndarray | None = None  # (Vb, 3) positions of the body vertices
 
     @property
     def bone_names(self) -> tuple[str, ...]:
@@ -77,7 +78,6 @@ def autorig(mesh: Mesh, levels: int = LEVELS) -> AutoRig:
     graph = mesh_graph(mesh.vertices, mesh.faces)
     comp = connected_components(graph.n, graph.edges)
     _check_single_body(mesh, comp)
-    body = np.flatnonzero(comp == 0)
     face_in = np.all(comp[mesh.faces] == 0, axis=1)
     body_mesh, used = mesh.submesh(np.flatnonzero(face_in))
     if len(used) < 50:
@@ -105,12 +105,24 @@ def autorig(mesh: Mesh, levels: int = LEVELS) -> AutoRig:
     seg_all[body] = segment
     others = np.setdiff1d(np.arange(len(mesh.vertices)), body)
     if len(others):
-        sample = np.arange(0, len(v), 4)  # a quarter of the body is plenty to tell which part a piece sits on
-        seg_all[others] = segment[sample[_nearest(mesh.vertices[others], v[sample])]]
+        seg_all[others] = _segment_of_nearest(mesh.vertices[others], v, segment)
     index, weight = bone_projection_weights(mesh.vertices, seg_all, joints, height, graph)
     timings["weights"] = time.perf_counter() - t0
     report = {"body_vertices": int(len(body)), "components": int(comp.max()) + 1,
               "bound_vertices": int(len(others)), "feature_points": {l: v[i].tolist() for l, i in zip(LABELS, fp.vertices)},
               "up": fp.up.tolist(), "front": fp.front.tolist(), "seconds": time.perf_counter() - t0,
               "timings": timings, "points_per_level": paper.count_per_level(levels).tolist()}
-    return AutoRig(KINECT_V1, joints, index, weight, body, segment, fp, paper, height, report)
+    return AutoRig(KINECT_V1, joints, index, weight, body, segment, fp, paper, height, report, v)
+
+
+def _segment_of_nearest(points: np.ndarray, body: np.ndarray, segment: np.ndarray) -> np.ndarray:
+    sample = np.arange(0, len(body), 4)  # a quarter of the body is plenty to tell which part a piece sits on
+    return segment[sample[_nearest(points, body[sample])]]
+
+
+def bind_mesh(rig: AutoRig, mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:
+    """Skin weights (V, 4) for another mesh in the same space as the rigged body (clothes, hair, eyes
+    kept as separate objects): each vertex follows the body part nearest to it."""
+    segment = _segment_of_nearest(mesh.vertices, rig.body_points, rig.segment)
+    graph = mesh_graph(mesh.vertices, mesh.faces) if len(mesh.faces) else None
+    return bone_projection_weights(mesh.vertices, segment, rig.joints, rig.height, graph)

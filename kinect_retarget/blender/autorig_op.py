@@ -6,9 +6,10 @@ import json
 
 import bpy
 import numpy as np
-from bpy.props import EnumProperty, IntProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, IntProperty, StringProperty
 
 from ..autorig import AutoRig, Mesh, MeshError, autorig
+from ..autorig.autorig import bind_mesh
 from ..autorig.weights import bone_segments
 
 AUTORIG_TAG = "kinect_retarget_autorig"
@@ -77,16 +78,20 @@ def build_armature(context, rig: AutoRig, name: str, collection) -> bpy.types.Ob
     return obj
 
 
-def assign_weights(mesh_obj: bpy.types.Object, rig: AutoRig) -> None:
-    """One vertex group per bone from the (V, 4) influences (existing groups of those names are replaced)."""
+def assign_weights(mesh_obj: bpy.types.Object, rig: AutoRig, index: np.ndarray | None = None,
+                   weight: np.ndarray | None = None) -> None:
+    """One vertex group per bone from (V, 4) influences, the rig's own by default (existing groups of
+    those names are replaced)."""
+    index = rig.weight_index if index is None else index
+    weight = rig.weight if weight is None else weight
     groups = mesh_obj.vertex_groups
     for name in rig.bone_names:
         if name in groups:
             groups.remove(groups[name])
     for b, name in enumerate(rig.bone_names):
         group = groups.new(name=name)
-        rows, slots = np.nonzero((rig.weight_index == b) & (rig.weight > 0))
-        w = rig.weight[rows, slots]
+        rows, slots = np.nonzero((index == b) & (weight > 0))
+        w = weight[rows, slots]
         # vertex_group.add takes one weight per call: batch the vertices that share a (rounded) weight
         key = np.round(w, 4)
         order = np.argsort(key, kind="stable")
@@ -122,9 +127,22 @@ def _heat_weights(context, mesh_obj, arm_obj, rig: AutoRig) -> str:
     return ""
 
 
+def _parent_with_modifier(obj: bpy.types.Object, arm_obj: bpy.types.Object) -> None:
+    world = obj.matrix_world.copy()
+    obj.parent = arm_obj
+    obj.matrix_parent_inverse = arm_obj.matrix_world.inverted()
+    obj.matrix_world = world
+    if not any(m.type == "ARMATURE" for m in obj.modifiers):
+        mod = obj.modifiers.new("Armature", "ARMATURE")
+        mod.object = arm_obj
+
+
 def rig_mesh_object(context, mesh_obj: bpy.types.Object, weights: str = "PROJECTION", levels: int = 4,
-                    name: str | None = None) -> tuple[bpy.types.Object, AutoRig, str]:
-    """Rig `mesh_obj` in place. Raises MeshError (scene untouched) when no human skeleton can be built."""
+                    name: str | None = None, extra=()) -> tuple[bpy.types.Object, AutoRig, str]:
+    """Rig `mesh_obj` in place; `extra` mesh objects (clothes, eyes, hair kept apart) are bound to the
+    same armature. Raises MeshError (scene untouched) when no human skeleton can be built."""
+    extra = [o for o in extra if o is not mesh_obj and o.type == "MESH" and len(o.data.polygons)
+             and not any(m.type == "ARMATURE" for m in o.modifiers)]
     if mesh_obj is None or mesh_obj.type != "MESH":
         raise MeshError("select a mesh object to auto-rig")
     if any(m.type == "ARMATURE" for m in mesh_obj.modifiers):
@@ -137,18 +155,19 @@ def rig_mesh_object(context, mesh_obj: bpy.types.Object, weights: str = "PROJECT
     arm_obj = build_armature(context, rig, name or f"{mesh_obj.name}_Rig", collection)
     try:
         arm_obj[AUTORIG_TAG] = json.dumps({k: v for k, v in rig.report.items() if k != "timings"})
-        world = mesh_obj.matrix_world.copy()
-        mesh_obj.parent = arm_obj
-        mesh_obj.matrix_parent_inverse = arm_obj.matrix_world.inverted()
-        mesh_obj.matrix_world = world
+        _parent_with_modifier(mesh_obj, arm_obj)
         note = ""
         if weights == "HEAT":
             note = _heat_weights(context, mesh_obj, arm_obj, rig)
         else:
             assign_weights(mesh_obj, rig)
-        if not any(m.type == "ARMATURE" for m in mesh_obj.modifiers):
-            mod = mesh_obj.modifiers.new("Armature", "ARMATURE")
-            mod.object = arm_obj
+        for obj in extra:
+            v, t = mesh_world_arrays(obj)
+            index, weight = bind_mesh(rig, Mesh(v, t, obj.name))
+            assign_weights(obj, rig, index, weight)
+            _parent_with_modifier(obj, arm_obj)
+        if extra:
+            note += f"; bound {len(extra)} more mesh object(s): {', '.join(o.name for o in extra)}"
     except Exception:
         bpy.data.objects.remove(arm_obj)  # leave the scene as it was
         raise
@@ -167,6 +186,8 @@ class KINECT_RETARGET_OT_autorig_mesh(bpy.types.Operator):
     levels: IntProperty(name="Levels (K)", description="Topological levels of the paper's skeleton points",
                         default=4, min=2, max=7)
     rig_name: StringProperty(name="Armature Name", description="Empty: '<mesh>_Rig'", default="")
+    bind_selected: BoolProperty(name="Bind Other Selected Meshes", default=True,
+                                description="Clothes, eyes or hair kept as separate objects follow the new rig")
 
     @classmethod
     def poll(cls, context):
@@ -182,8 +203,9 @@ class KINECT_RETARGET_OT_autorig_mesh(bpy.types.Operator):
     def execute(self, context):
         mesh_obj = context.active_object
         try:
+            extra = context.selected_objects if self.bind_selected else ()
             arm_obj, _, summary = rig_mesh_object(context, mesh_obj, self.weights, self.levels,
-                                                  self.rig_name or None)
+                                                  self.rig_name or None, extra)
         except MeshError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}

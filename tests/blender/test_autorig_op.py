@@ -115,3 +115,28 @@ def test_heat_weights_option(registered, body):
     assert set(names.values()) >= set(KINECT_V1.joints)
     assert count.max() <= 4 and count.min() >= 1
     np.testing.assert_allclose(total, 1.0, atol=1e-3)
+
+
+def test_other_selected_meshes_are_bound(registered, body):
+    """A garment kept as its own object (here: a shell around the left arm) follows the same rig."""
+    bpy = registered
+    from kinect_retarget.blender.autorig_op import new_mesh_object
+    v, f = body
+    left_arm = v[:, 0] > 0.25
+    keep = left_arm[f].all(axis=1)
+    used, inv = np.unique(f[keep], return_inverse=True)
+    normals_out = (v[used] - v[used].mean(axis=0)) * 0.02
+    sleeve = new_mesh_object("Sleeve", v[used] + normals_out, inv.reshape(-1, 3), bpy.context.scene.collection)
+    obj = _add_body(bpy, body)
+    sleeve.select_set(True)
+    assert bpy.ops.kinect_retarget.autorig_mesh() == {"FINISHED"}
+    arm = bpy.context.active_object
+    assert sleeve.parent == arm and any(m.type == "ARMATURE" and m.object == arm for m in sleeve.modifiers)
+    names, count, total = _weights(sleeve)
+    np.testing.assert_allclose(total, 1.0, atol=1e-3)
+    top = {}
+    for vert in sleeve.data.vertices:
+        g = max(vert.groups, key=lambda g: g.weight)
+        top[names[g.group]] = top.get(names[g.group], 0) + 1
+    assert max(top, key=top.get) in ("ElbowLeft", "WristLeft", "HandLeft")
+    assert obj.parent == arm
