@@ -18,6 +18,8 @@ def add_parser(sub) -> None:
     p.add_argument("--group", help="OBJ group or object to rig (e.g. 'body' for MakeHuman's base.obj)")
     p.add_argument("--weights", choices=("projection", "heat"), default="projection",
                    help="skin weights: the paper's bone projection (default) or Blender's bone heat")
+    p.add_argument("--levels", type=int, default=4, choices=range(2, 8), metavar="K",
+                   help="topological levels of the paper's skeleton points (2-7, default 4)")
     p.add_argument("--keep-transform", action="store_true",
                    help="keep the file's axes and units (default: stand the mesh Z-up, facing -Y, in metres)")
     p.set_defaults(handler=run)
@@ -37,7 +39,7 @@ def run(args) -> int:
         from .takes import load_take
         take = load_take(args.take)
         take.metadata.setdefault("name", os.path.splitext(os.path.basename(args.take))[0])
-    rig = autorig(mesh)  # not a human: a clear MeshError now, before Blender starts
+    rig = autorig(mesh, levels=args.levels)  # not a human: a clear MeshError now, before Blender starts
     vertices = mesh.vertices
     if not args.keep_transform:
         m = upright_transform(mesh.vertices, np.asarray(rig.features.up), np.asarray(rig.features.front),
@@ -47,6 +49,7 @@ def run(args) -> int:
     from .blender.autorig_op import autorig_to_file
 
     summary = autorig_to_file(Mesh(vertices, mesh.faces, name), args.out, take=take, render_dir=args.render,
-                              frames=args.frames, weights=args.weights.upper())
+                              frames=args.frames, weights=args.weights.upper(),
+                              levels=args.levels)
     print(json.dumps(summary))
     return 0

@@ -46,7 +46,7 @@ class AutoRig:
         r = self.report
         return (f"auto-rig: {len(self.joints)} joints from a body of {r['body_vertices']} vertices "
                 f"(height {self.height:.3g} units, {r['components']} mesh pieces, {r['bound_vertices']} vertices "
-                f"bound from other pieces), {len(self.paper.points)} skeleton points over {LEVELS} levels, "
+                f"bound from other pieces), {len(self.paper.points)} skeleton points over {r['levels']} levels, "
                 f"{r['seconds']:.2f} s")
 
 
@@ -111,7 +111,7 @@ def autorig(mesh: Mesh, levels: int = LEVELS) -> AutoRig:
     report = {"body_vertices": int(len(body)), "components": int(comp.max()) + 1,
               "bound_vertices": int(len(others)), "feature_points": {l: v[i].tolist() for l, i in zip(LABELS, fp.vertices)},
               "up": fp.up.tolist(), "front": fp.front.tolist(), "seconds": time.perf_counter() - t0,
-              "timings": timings, "points_per_level": paper.count_per_level(levels).tolist()}
+              "timings": timings, "levels": levels, "points_per_level": paper.count_per_level(levels).tolist()}
     return AutoRig(KINECT_V1, joints, index, weight, body, segment, fp, paper, height, report, v)
 
 

@@ -233,7 +233,7 @@ CLASSES = (KINECT_RETARGET_OT_autorig_mesh,)
 
 
 def autorig_to_file(mesh: Mesh, out_path: str, *, take=None, render_dir: str | None = None, frames: int = 6,
-                    weights: str = "PROJECTION") -> dict:
+                    weights: str = "PROJECTION", levels: int = 4) -> dict:
     """Headless: a fresh scene holding `mesh` rigged (and `take` baked on it), saved to out_path."""
     import os
 
@@ -242,9 +242,10 @@ def autorig_to_file(mesh: Mesh, out_path: str, *, take=None, render_dir: str | N
     scene = context.scene
     obj = new_mesh_object(mesh.name, mesh.vertices, mesh.faces, scene.collection)
     context.view_layer.objects.active = obj
-    arm, rig, summary = rig_mesh_object(context, obj, weights)
+    arm, rig, summary = rig_mesh_object(context, obj, weights, levels)
     out = {"out": out_path, "mesh": obj.name, "armature": arm.name, "vertices": len(mesh.vertices),
-           "height_m": round(float(np.ptp(mesh.vertices[:, 2])), 4), "summary": summary}
+           "height_m": round(float(np.ptp(mesh.vertices[:, 2])), 4), "summary": summary,
+           "points_per_level": rig.report["points_per_level"]}
     render_frames = [scene.frame_current]
     if take is not None:
         from .bake_take import bake_take
