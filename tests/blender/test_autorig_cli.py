@@ -33,3 +33,28 @@ def test_autorig_cli_bad_input(tmp_path, capsys, content, message):
     err = capsys.readouterr().err
     assert message in err and "thing.obj" in err and "Traceback" not in err
     assert not (tmp_path / "o.blend").exists()
+
+
+@pytest.mark.parametrize("fmt", ["glb", "ply"])
+def test_blender_exported_files_rig_like_the_source(bpy_empty, shared_data, tmp_path, fmt):
+    """GLB (Y-up by the glTF spec) and PLY (Z-up) written by Blender itself load and rig to the same joints."""
+    import numpy as np
+
+    from kinect_retarget.autorig import autorig, load_mesh
+    from kinect_retarget.blender.autorig_op import new_mesh_object
+    bpy = bpy_empty
+    src = load_mesh(shared_data / "meshes" / "makehuman" / "base.obj", group="body")
+    z_up = src.vertices @ np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], float).T * 0.1
+    obj = new_mesh_object("Body", z_up, src.faces, bpy.context.scene.collection)
+    obj.select_set(True)
+    bpy.context.view_layer.objects.active = obj
+    path = tmp_path / f"body.{fmt}"
+    if fmt == "glb":
+        bpy.ops.export_scene.gltf(filepath=str(path), export_format="GLB", use_selection=True)
+        expected = src.vertices * 0.1  # glTF is Y-up: back to the OBJ's axes, in metres
+    else:
+        bpy.ops.wm.ply_export(filepath=str(path), export_selected_objects=True, ascii_format=False)
+        expected = z_up
+    rig = autorig(load_mesh(path))
+    ref = autorig(type(src)(expected, src.faces, "ref"))
+    np.testing.assert_allclose(rig.joints, ref.joints, atol=2e-4)
