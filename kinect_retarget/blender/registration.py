@@ -8,7 +8,7 @@ import bpy
 
 # Modules in registration order (property groups before the classes that point at them).
 MODULES = ("operators",)
-OPTIONAL_MODULES = ("preferences", "properties", "live", "mapping_ui", "panels", "autorig_op", "lift_op")
+OPTIONAL_MODULES = ("preferences", "properties", "live", "mapping_ui", "panels", "usb_panel", "autorig_op", "lift_op")
 
 _registered: list = []
 _hooks: list = []
