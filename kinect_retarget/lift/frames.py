@@ -42,9 +42,9 @@ def load_frame(path: str) -> np.ndarray:
     ch = 3 if kind == b"P6" else 1
     dtype = ">u2" if maxval > 255 else "u1"
     count = w * h * ch
-    pix = np.frombuffer(data, dtype=dtype, count=count, offset=m.end()) if len(data) >= m.end() + count * np.dtype(dtype).itemsize else None
-    if pix is None:
+    if len(data) < m.end() + count * np.dtype(dtype).itemsize:
         raise LiftError(f"{path}: image data truncated ({w}x{h})")
+    pix = np.frombuffer(data, dtype=dtype, count=count, offset=m.end())
     img = pix.reshape(h, w, ch).astype(np.float32) / maxval
     return np.repeat(img, 3, axis=2) if ch == 1 else img
 

@@ -26,10 +26,10 @@ from .tracks2d import LiftError, Tracks2D
 
 SK = KINECT_V1
 PARENTS = SK.parent_array
-# Parents before children, shallow joints first (both hips are placed before any foot needs "forward").
 
 
 def _shallow_first_order() -> np.ndarray:
+    """Parents before children, shallow joints first (both hips are placed before a foot needs "forward")."""
     depth = np.zeros(len(SK), dtype=np.int64)
     for j in topological_order(SK)[1:]:
         depth[j] = depth[PARENTS[j]] + 1
@@ -82,7 +82,7 @@ def lift(tracks: Tracks2D, settings: LiftSettings | None = None, *, scale: np.nd
     if st.scale not in ("paper", "envelope"):
         raise LiftError(f"unknown scale method {st.scale!r} (envelope, paper)")
     problems = list(tracks.problems)
-    lengths = np.asarray(st.lengths, dtype=np.float64) if st.lengths is not None else lengths_from_height(st.height_m)
+    lengths = lengths_from_height(st.height_m) if st.lengths is None else np.asarray(st.lengths, dtype=float)
     if lengths.shape != (len(SK),) or np.any(lengths[PARENTS >= 0] <= 0):
         raise LiftError(f"bone lengths must be {len(SK)} positive values (one per joint, root 0)")
     cam = _camera(tracks, st, problems)
@@ -93,6 +93,9 @@ def lift(tracks: Tracks2D, settings: LiftSettings | None = None, *, scale: np.nd
     uv = gaussian_smooth(uv, have[..., None], tracks.times, st.smooth_2d_s)
     sigma_px = noise_px * _smoothing_gain(tracks.times, st.smooth_2d_s) if st.noise_aware else 0.0
     body = have[:, SK.root]
+    if not body.any():
+        raise LiftError(f"{tracks.source}: the hips (HipCenter, or both hips) are never visible: the body "
+                        f"cannot be placed")
     for i in np.flatnonzero(~body & have.any(axis=1)):
         problems.append(f"{tracks.source}: {tracks.frame_label(i)}: hips not visible, frame left untracked")
     measured = present & ~tracks.inferred
@@ -104,7 +107,8 @@ def lift(tracks: Tracks2D, settings: LiftSettings | None = None, *, scale: np.nd
 
     z_root = cam.focal_px / s
     lines = JointLines.build(uv, cam, z_root, st.focal_px is not None, sigma_px)
-    root = lines.origin[:, SK.root] + lines.direction[:, SK.root] * (z_root / lines.direction[:, SK.root, 2])[:, None]
+    r = SK.root
+    root = lines.origin[:, r] + lines.direction[:, r] * (z_root / lines.direction[:, r, 2])[:, None]
     if signs is None:
         travel = _travel_direction(root, tracks.times, body)
         signs = choose_signs(lines, lengths, root, tracks.times, body, travel, st.priors, st.signs)

@@ -119,8 +119,8 @@ def write_frame(path: str, uv: np.ndarray, conf: np.ndarray) -> None:
     """One OpenPose BODY_25 file: uv (25, 2) pixels, conf (25,) (0 where missing)."""
     kp = np.concatenate([np.nan_to_num(uv), conf[:, None]], axis=1)
     kp[conf <= 0] = 0.0
-    data = {"version": 1.3, "people": [{"person_id": [-1], "pose_keypoints_2d": [round(float(v), 3) for v in kp.ravel()],
-                                        "face_keypoints_2d": [], "hand_left_keypoints_2d": [],
-                                        "hand_right_keypoints_2d": []}]}
+    person = {"person_id": [-1], "pose_keypoints_2d": [round(float(v), 3) for v in kp.ravel()],
+              "face_keypoints_2d": [], "hand_left_keypoints_2d": [], "hand_right_keypoints_2d": []}
+    data = {"version": 1.3, "people": [person]}
     with open(path, "w", encoding="utf-8") as fh:
         json.dump(data, fh)

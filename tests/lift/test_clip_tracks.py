@@ -38,10 +38,12 @@ def _track(name, frames, uv, enabled=None):
 
 def test_named_tracks_to_kinect_joints():
     f = np.arange(10, 20)
-    tracks = [_track("l_hip", f, np.c_[f + 100, np.full(10, 300)]), _track("r_hip", f, np.c_[f + 60, np.full(10, 300)]),
+    tracks = [_track("l_hip", f, np.c_[f + 100, np.full(10, 300)]),
+              _track("r_hip", f, np.c_[f + 60, np.full(10, 300)]),
               _track("l_shoulder", f, np.c_[f + 110, np.full(10, 150)]),
               _track("r_shoulder", f, np.c_[f + 50, np.full(10, 150)], enabled=[True] * 5 + [False] * 5),
-              _track("l_elbow", f, np.c_[f + 115, np.full(10, 200)]), _track("l_wrist", f, np.c_[f + 118, np.full(10, 250)]),
+              _track("l_elbow", f, np.c_[f + 115, np.full(10, 200)]),
+              _track("l_wrist", f, np.c_[f + 118, np.full(10, 250)]),
               _track("Track.004", f, np.zeros((10, 2)))]
     t = tracks_from_named(tracks, 24.0, (640, 480), "clip 'walk'")
     assert t.frame_count == 10 and np.allclose(np.diff(t.times), 1 / 24)

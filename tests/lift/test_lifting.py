@@ -135,3 +135,12 @@ def test_unknown_focal_still_gives_the_pose(walk, rng):
     res = lift(tracks, LiftSettings(lengths=lengths_from_take(walk)))  # focal unknown
     assert not res.take.metadata["focal_known"]
     assert mpjpe(procrustes_align(res.take.positions, truth.positions), truth.positions) < 0.06
+
+
+def test_hips_never_visible_is_a_clear_error(walk):
+    truth = seen_from(walk, 0.0)
+    tracks = tracks_from_take(truth, camera(), IMAGE)
+    for name in ("HipCenter", "HipLeft", "HipRight"):
+        tracks.confidence[:, KINECT_V1.index(name)] = 0
+    with pytest.raises(LiftError, match="hips .* are never visible"):
+        lift(tracks, LiftSettings(focal_px=FOCAL))
