@@ -86,3 +86,18 @@ def test_cli_track_then_lift(sequence, tmp_path):
     take = load_take(out)
     assert take.frame_count == 12 and take.skeleton is KINECT_V1
     assert main(["lift", str(tmp_path / "nothing"), "--format", "openpose", "--out", str(out)]) == 2
+
+
+def test_hidden_joint_is_reported_lost_then_found_again(sequence):
+    images, uv = sequence
+    j = KINECT_V1.index("WristRight")
+    hidden = [im.copy() for im in images]
+    for f in range(10, 16):  # cover the right wrist with a grey card for six frames
+        u, v = np.round(uv[f, j]).astype(int)
+        hidden[f][max(v - 14, 0):v + 15, max(u - 14, 0):u + 15] = 0.5
+    init = {"WristRight": tuple(uv[0, j]), "KneeLeft": tuple(uv[0, KINECT_V1.index("KneeLeft")])}
+    tr = JointTracker(hidden[0], init, TrackerSettings(seed=2))
+    res = [tr.initial()] + [tr.step(im) for im in hidden[1:]]
+    found = np.array([r.found[0] for r in res])
+    assert (~found[10:16]).sum() >= 4  # the card hides it (the edge of the forearm may still match)
+    assert found[:10].all() and found[20:].mean() > 0.8
