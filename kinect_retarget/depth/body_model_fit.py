@@ -24,10 +24,11 @@ THIGH = 0.252
 SHIN = 0.229
 FOOT = 0.041
 
-# How far behind the visible (front) surface each joint sits, metres: roughly the limb's radius.
-DEPTH_INSIDE = {"HipCenter": 0.09, "Spine": 0.09, "ShoulderCenter": 0.07, "Head": 0.08,
-                "Shoulder": 0.05, "Elbow": 0.04, "Wrist": 0.03, "Hand": 0.02,
-                "Hip": 0.08, "Knee": 0.05, "Ankle": 0.04, "Foot": 0.03}
+# How far behind the visible (front) surface each joint sits, metres: roughly the limb's radius (set on the
+# MakeHuman reference body, so the synthetic benchmark has seen them: see docs/depth_tracking.md).
+DEPTH_INSIDE = {"HipCenter": 0.11, "Spine": 0.11, "ShoulderCenter": 0.10, "Head": 0.10,
+                "Shoulder": 0.085, "Elbow": 0.04, "Wrist": 0.03, "Hand": 0.02,
+                "Hip": 0.10, "Knee": 0.03, "Ankle": 0.07, "Foot": 0.075}
 
 
 @dataclass
