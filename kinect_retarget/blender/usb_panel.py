@@ -259,8 +259,9 @@ def _upload(rgba: np.ndarray) -> None:
     img.update()
     if _rt.previews is not None:   # the sidebar shows it through a custom preview (template_icon)
         icon = _rt.previews.get("depth") or _rt.previews.new("depth")
-        icon.image_size = (w, h)
-        icon.image_pixels_float.foreach_set(flat)
+        if tuple(icon.image_size) != (w, h):
+            icon.image_size = (w, h)   # reallocates: only when the size changes
+        icon.image_pixels_float.foreach_set(flat)   # drawn from these pixels on the next redraw
 
 
 def update_preview() -> float | None:

@@ -22,6 +22,7 @@ from kinect_retarget.device import EmulatedKinect, LibusbMissing, list_devices, 
 from kinect_retarget.device.calibration import Calibration
 from kinect_retarget.device.depth_images import load_fakenect_dir
 from kinect_retarget.device.emulated import DEFAULT_SERIAL
+from kinect_retarget.sources import SourceError
 
 FAKENECT = ("depth_real", "fakenect_openiss", "fakenect-record")
 PREVIEW_W, PREVIEW_H = 320, 240
@@ -198,6 +199,31 @@ def test_live_on_the_simulated_kinect_previews_person_and_skeleton(registered, m
     assert st.state == "streaming" and st.frames >= 2
     live.stop_live(bake=False)
     assert usb_panel.update_preview() is None
+
+
+def test_live_while_the_simulated_kinect_is_prepared_says_so(registered, monkeypatch, fakenect_frames):
+    gate = threading.Event()
+
+    def slow_images():
+        gate.wait(10.0)                                  # stands in for the first render (about a minute)
+        return list(fakenect_frames), "fakenect test frames"
+    monkeypatch.setattr(usb_panel, "simulated_images", slow_images)
+    scene = registered
+    scene.kinect_retarget_usb.simulate = True
+    obj = build_kinect_rig(scene, KINECT_V1, typical_lengths(KINECT_V1), "KinectRig")
+    bpy.context.view_layer.objects.active = obj
+    scene.kinect_retarget.initialised = True
+    try:
+        with pytest.raises(SourceError, match="being prepared"):
+            live.start_live(bpy.context, use_timer=False)
+        assert live.controller() is None
+        text = " ".join(t for kind, t in _draw(bpy.context) if kind == "label")
+        assert "Preparing the simulated Kinect" in text
+    finally:
+        gate.set()
+    assert usb_panel.wait_for_discovery(10.0) and usb_panel.devices()[0]["serial"] == DEFAULT_SERIAL
+    c = live.start_live(bpy.context, use_timer=False)    # ready now
+    assert c.source_label == "simulated USB Kinect"
 
 
 # -- panel and unregister ---------------------------------------------------------------------------------------
