@@ -137,6 +137,19 @@ def _parent_with_modifier(obj: bpy.types.Object, arm_obj: bpy.types.Object) -> N
         mod.object = arm_obj
 
 
+def _roll_back(saved, arm_obj) -> None:
+    """Undo a half-done rig: modifiers, vertex groups and parents as they were, the armature gone."""
+    for obj, parent, parent_inverse, world, groups in saved:
+        for mod in [m for m in obj.modifiers if m.type == "ARMATURE" and m.object == arm_obj]:
+            obj.modifiers.remove(mod)
+        for group in [g for g in obj.vertex_groups if g.name not in groups]:
+            obj.vertex_groups.remove(group)
+        obj.parent = parent
+        obj.matrix_parent_inverse = parent_inverse
+        obj.matrix_world = world
+    bpy.data.objects.remove(arm_obj)
+
+
 def rig_mesh_object(context, mesh_obj: bpy.types.Object, weights: str = "PROJECTION", levels: int = 4,
                     name: str | None = None, extra=()) -> tuple[bpy.types.Object, AutoRig, str]:
     """Rig `mesh_obj` in place; `extra` mesh objects (clothes, eyes, hair kept apart) are bound to the
@@ -153,6 +166,8 @@ def rig_mesh_object(context, mesh_obj: bpy.types.Object, weights: str = "PROJECT
     rig = autorig(Mesh(verts, tris, mesh_obj.name), levels=levels)  # may raise: nothing changed yet
     collection = mesh_obj.users_collection[0] if mesh_obj.users_collection else context.scene.collection
     arm_obj = build_armature(context, rig, name or f"{mesh_obj.name}_Rig", collection)
+    saved = [(o, o.parent, o.matrix_parent_inverse.copy(), o.matrix_world.copy(), {g.name for g in o.vertex_groups})
+             for o in [mesh_obj, *extra]]
     try:
         arm_obj[AUTORIG_TAG] = json.dumps({k: v for k, v in rig.report.items() if k != "timings"})
         _parent_with_modifier(mesh_obj, arm_obj)
@@ -169,7 +184,7 @@ def rig_mesh_object(context, mesh_obj: bpy.types.Object, weights: str = "PROJECT
         if extra:
             note += f"; bound {len(extra)} more mesh object(s): {', '.join(o.name for o in extra)}"
     except Exception:
-        bpy.data.objects.remove(arm_obj)  # leave the scene as it was
+        _roll_back(saved, arm_obj)
         raise
     return arm_obj, rig, rig.summary() + note
 
@@ -208,6 +223,9 @@ class KINECT_RETARGET_OT_autorig_mesh(bpy.types.Operator):
                                                   self.rig_name or None, extra)
         except MeshError as exc:
             self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        except (RuntimeError, ValueError, MemoryError) as exc:  # rolled back already; say what happened
+            self.report({"ERROR"}, f"Auto-rig failed, nothing was changed: {exc}")
             return {"CANCELLED"}
         for o in context.view_layer.objects:
             o.select_set(False)

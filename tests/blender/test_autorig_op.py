@@ -140,3 +140,22 @@ def test_other_selected_meshes_are_bound(registered, body):
         top[names[g.group]] = top.get(names[g.group], 0) + 1
     assert max(top, key=top.get) in ("ElbowLeft", "WristLeft", "HandLeft")
     assert obj.parent == arm
+
+
+def test_failure_after_armature_is_rolled_back(registered, body, monkeypatch):
+    """If anything fails half-way (here: writing the weights), the mesh is left exactly as it was."""
+    bpy = registered
+    from kinect_retarget.blender import autorig_op
+    obj = _add_body(bpy, body, location=(0.5, 0.0, 0.0))
+    obj.vertex_groups.new(name="mine")
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(autorig_op, "assign_weights", broken)
+    with pytest.raises(RuntimeError, match="disk full"):
+        autorig_op.rig_mesh_object(bpy.context, obj)
+    assert obj.parent is None and not obj.modifiers and [g.name for g in obj.vertex_groups] == ["mine"]
+    assert not bpy.data.armatures or all(a.users == 0 for a in bpy.data.armatures)
+    assert [o.type for o in bpy.data.objects] == ["MESH"]
+    np.testing.assert_allclose(np.array(obj.matrix_world)[:3, 3], [0.5, 0, 0], atol=1e-6)
