@@ -421,6 +421,10 @@ class KINECT_RETARGET_OT_usb_preview(bpy.types.Operator):
 
 
 # -- the panel --------------------------------------------------------------------------------------------------
+_STATE_ICONS = {"streaming": "REC", "connecting": "TIME", "waiting for device": "TIME", "unplugged": "UNLINKED",
+                "error": "ERROR", "stopped": "PAUSE"}
+
+
 def _wrapped(layout, text: str, icon: str = "NONE", width_px: int = 280, alert: bool = False) -> None:
     """Labels do not wrap: split long sentences (device problems, fixes) to the sidebar's width."""
     col = layout.column(align=True)
@@ -499,8 +503,8 @@ class KINECT_RETARGET_PT_usb(bpy.types.Panel):
         if st is None:
             box.label(text="Not streaming", icon="BLANK1")
             return
-        _wrapped(box, f"{st.state}: {st.message}", "ERROR" if st.state == "error" else "INFO", width,
-                 alert=st.state in ("error", "unplugged"))
+        message = st.message[:1].upper() + st.message[1:] if st.message else st.state.capitalize()
+        _wrapped(box, message, _STATE_ICONS.get(st.state, "INFO"), width, alert=st.state in ("error", "unplugged"))
         col = box.column(align=True)
         col.label(text=f"{st.fps:.1f} frames/s · {st.frames} frames")
         col.label(text=f"dropped {st.frames_dropped} · reconnects {st.reconnects}"

@@ -227,27 +227,54 @@ def test_live_while_the_simulated_kinect_is_prepared_says_so(registered, monkeyp
 
 
 # -- panel and unregister ---------------------------------------------------------------------------------------
+_UI = bpy.types.UILayout.bl_rna.functions
+_ICONS = {i.identifier for i in _UI["label"].parameters["icon"].enum_items}
+
+
 class _FakeLayout:
-    """Records what draw() puts on screen."""
+    """Records what draw() puts on screen; checks every call against the real UILayout's parameters."""
 
     def __init__(self, log):
         self.log, self.alert, self.enabled, self.scale_y = log, False, True, 1.0
 
-    def _child(self, *a, **k):
-        return _FakeLayout(self.log)
-    row = column = box = _child
+    @staticmethod
+    def _check(fn, kwargs):
+        params = _UI[fn].parameters
+        unknown = set(kwargs) - set(params.keys())
+        assert not unknown, f"UILayout.{fn} has no parameter {unknown}"
+        assert kwargs.get("icon", "NONE") in _ICONS, kwargs["icon"]
 
-    def label(self, text="", icon="NONE", **k):
-        self.log.append(("label", text))
+    def _child(self, **k):
+        return _FakeLayout(self.log)
+
+    def row(self, **k):
+        self._check("row", k)
+        return self._child()
+
+    def column(self, **k):
+        self._check("column", k)
+        return self._child()
+
+    def box(self):
+        return self._child()
+
+    def label(self, **k):
+        self._check("label", k)
+        self.log.append(("label", k.get("text", "")))
 
     def prop(self, data, prop, **k):
+        self._check("prop", k)
+        assert prop in data.bl_rna.properties, prop
         self.log.append(("prop", prop))
 
     def operator(self, idname, **k):
+        self._check("operator", k)
+        assert hasattr(getattr(bpy.ops, idname.split(".")[0]), idname.split(".")[1]), idname
         self.log.append(("operator", idname))
 
-    def template_icon(self, icon_value=0, scale=1.0):
-        self.log.append(("icon", icon_value))
+    def template_icon(self, **k):
+        self._check("template_icon", k)
+        self.log.append(("icon", k["icon_value"]))
 
 
 def _draw(context) -> list:
