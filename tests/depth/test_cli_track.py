@@ -61,3 +61,24 @@ def test_all_zero_capture_gives_an_untracked_take(tmp_path):
     out = tmp_path / "empty.krtake"
     assert main(["track", str(path), "--out", str(out)]) == 0
     assert np.all(load_take(out).states == NOT_TRACKED)
+
+
+def test_track_replays_a_usb_packet_dump(rendered, tmp_path):
+    from kinect_retarget.device.dump import DumpWriter
+    from kinect_retarget.device.emulated_stream import packets_for_frames
+    seq, _ = rendered
+    dump = tmp_path / "capture.dump"
+    with DumpWriter(dump) as w:
+        w.write_packets(packets_for_frames(list(seq.raw[:4]), 4))
+    out = tmp_path / "replay.krtake"
+    assert main(["track", "--replay", str(dump), "--out", str(out)]) == 0
+    take = load_take(out)
+    assert take.frame_count == 4
+    np.testing.assert_allclose(np.diff(take.times), 1 / 30, atol=1e-3)
+    assert np.all(take.states != NOT_TRACKED)
+    assert np.linalg.norm(take.positions[:, 0] - seq.joints[:4, 0], axis=-1).max() < 0.1
+    # a truncated dump still gives the frames completed before the damage, with a warning
+    data = dump.read_bytes()
+    (tmp_path / "cut.dump").write_bytes(data[: len(data) * 3 // 4 + 7])
+    assert main(["track", "--replay", str(tmp_path / "cut.dump"), "--out", str(out)]) == 0
+    assert load_take(out).frame_count == 3
