@@ -90,7 +90,9 @@ def main() -> None:
           f"of height (goal <= 1 %)")
 
     print("\n== time, end to end (load excluded; graph, feature points, levels, joints, weights)")
+    shins = mh.body.vertices[mh.body.faces].mean(axis=1)[:, 1] < -4.0  # lower legs and feet split 1 -> 4
     meshes = [("body group", mh.body), ("whole base.obj (154 pieces)", mh.full),
+              ("body, lower legs subdivided", subdivide(mh.body, shins)),
               ("body subdivided x4", subdivide(mh.body))]
     for label, mesh in meshes:
         best, tm = np.inf, {}
