@@ -286,7 +286,8 @@ def update_preview() -> float | None:
 
 def ensure_timer() -> None:
     if not bpy.app.timers.is_registered(update_preview):
-        bpy.app.timers.register(update_preview, first_interval=0.0)
+        # persistent: a stream outlives a file load, so must the timer that shows it (the image is recreated)
+        bpy.app.timers.register(update_preview, first_interval=0.0, persistent=True)
 
 
 def _redraw() -> None:
@@ -459,6 +460,8 @@ class KINECT_RETARGET_PT_usb(bpy.types.Panel):
 
     @staticmethod
     def _draw_devices(layout, u, width):
+        st = stream_status()
+        streaming = st.device if st is not None and st.state == "streaming" else ""
         box = layout.box()
         row = box.row(align=True)
         row.label(text="Devices", icon="OUTLINER_OB_CAMERA")
@@ -482,9 +485,11 @@ class KINECT_RETARGET_PT_usb(bpy.types.Panel):
         for d in _rt.devices or ():
             col = box.column(align=True)
             col.label(text=f"{d['model']}  {d['serial']}", icon="CHECKMARK" if d["camera_available"] else "ERROR")
-            col.label(text="Camera: " + ("ready" if d["camera_available"] else "cannot be opened"), icon="BLANK1")
+            in_use = bool(streaming) and streaming.endswith(d["serial"])   # a busy camera may refuse a 2nd open
+            camera = "streaming" if in_use else "ready" if d["camera_available"] else "cannot be opened"
+            col.label(text=f"Camera: {camera}", icon="BLANK1")
             col.label(text="Motor: " + ("ready" if d["motor_available"] else "not available"), icon="BLANK1")
-            if d["problem"]:
+            if d["problem"] and not in_use:
                 _wrapped(col, d["problem"], "ERROR", width, alert=True)
         if u.simulate and _rt.sim_label:
             box.label(text=f"Simulated: {_rt.sim_label}", icon="INFO")

@@ -160,6 +160,14 @@ def test_depth_stream_preview_updates_the_image(registered, fakenect_frames):
     st = usb_panel.stream_status()
     assert st.state == "streaming" and st.frames >= 3 and st.reconnects == 0
 
+    # a file load keeps the stream, so the (persistent) timer goes on and recreates the image in the new file
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    assert bpy.app.timers.is_registered(usb_panel.update_preview) and usb_panel.stream_running()
+    frames = st.frames
+    _pump_until(lambda: usb_panel.stream_status().frames > frames)
+    usb_panel.update_preview()
+    assert usb_panel.IMAGE_NAME in bpy.data.images
+
     assert bpy.ops.kinect_retarget.usb_preview() == {"FINISHED"}   # the same button stops it
     assert not usb_panel.stream_running()
     assert usb_panel.update_preview() is None            # nothing runs: the timer ends itself
@@ -297,7 +305,7 @@ def test_panel_shows_devices_status_tilt_and_preview(registered, monkeypatch, fa
     usb_panel.update_preview()
     log = _draw(bpy.context)
     text = " | ".join(t for kind, t in log if kind == "label")
-    assert DEFAULT_SERIAL in text and "Camera: ready" in text and "Motor: ready" in text
+    assert DEFAULT_SERIAL in text and "Camera: streaming" in text and "Motor: ready" in text
     assert "frames/s" in text and "dropped 0" in text and "reconnects 0" in text
     assert ("prop", "tilt") in log and ("operator", "kinect_retarget.usb_tilt") in log
     assert ("prop", "simulate") in log and ("operator", "kinect_retarget.usb_refresh") in log
