@@ -1,6 +1,6 @@
 """Regenerate the pictures of docs/autorig.md (Workbench, headless):
 
-    .venv/bin/python docs/autorig/make_pictures.py
+    .venv/bin/python tools/make_autorig_pictures.py
 
 1. skeleton.png: MakeHuman's base mesh (CC0), see-through, with the extracted Kinect joints and bones (red)
    and the paper's skeleton points (blue); 2. take_f*.png: the auto-rigged mesh driven by a real Kinect v2
@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-REPO = HERE.parents[1]
+REPO = Path(__file__).resolve().parents[1]
+HERE = REPO / "docs" / "autorig"
 sys.path.insert(0, str(REPO))
 DATA = REPO.parent / "shared" / "data"
 
