@@ -118,10 +118,13 @@ def _simulate(context=None) -> bool:
 def _backend(context=None):
     """The pyusb backend to use: the emulated Kinect when simulating (SourceError while it is being prepared),
     None for real USB (pyusb's libusb1 backend)."""
-    if not _simulate(context):
-        return None
+    return _simulated_or_error() if _simulate(context) else None
+
+
+def _simulated_or_error() -> EmulatedKinect:
     backend = simulated_backend()
     if backend is None:
+        ensure_timer()   # the panel redraws when the preparation ends
         raise SourceError(_rt.sim_error or "the simulated Kinect is being prepared (rendering depth the first "
                                            "time takes about a minute); try again in a moment")
     return backend
@@ -306,7 +309,7 @@ def _make_source(settings, prefs):
     stop_stream()
     usb = getattr(settings.id_data, "kinect_retarget_usb", None)
     if usb is not None and usb.simulate:
-        backend = _backend()
+        backend = _simulated_or_error()
         factory, reason = find_skeleton_producer()
         if factory is None:
             raise SourceError(f"USB Kinect: {reason}")
