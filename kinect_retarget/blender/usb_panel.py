@@ -333,7 +333,7 @@ class KinectRetargetUsbSettings(bpy.types.PropertyGroup):
         description="Use an emulated Kinect streaming rendered depth of a real motion, for trying the whole "
                     "chain (devices, tilt, preview, live) without the hardware")
     tilt: FloatProperty(name="Tilt", subtype="ANGLE", default=0.0, min=-math.radians(TILT_LIMIT_DEG),
-                        max=math.radians(TILT_LIMIT_DEG), step=100,
+                        max=math.radians(TILT_LIMIT_DEG),
                         description="Motor angle from the horizon (the Kinect's limit is ±27°)")
     led: EnumProperty(name="LED", items=LED_ITEMS, default="green", description="Colour of the Kinect's LED")
     show_preview: BoolProperty(name="Depth Preview", default=True, description="Show the depth preview image")
@@ -456,7 +456,7 @@ class KINECT_RETARGET_PT_usb(bpy.types.Panel):
         region = getattr(context, "region", None)
         width = getattr(region, "width", 280) or 280
         self._draw_devices(layout, u, width)
-        self._draw_stream(layout, width)
+        self._draw_stream(layout, u, width)
         self._draw_motor(layout, u, width)
         if u.show_preview:
             self._draw_preview(layout)
@@ -498,13 +498,14 @@ class KINECT_RETARGET_PT_usb(bpy.types.Panel):
             box.label(text=f"Simulated: {_rt.sim_label}", icon="INFO")
 
     @staticmethod
-    def _draw_stream(layout, width):
+    def _draw_stream(layout, u, width):
         box = layout.box()
         st = stream_status()
         row = box.row(align=True)
         using_live = live_uses_usb()
         row.label(text="Stream" + (" (live)" if using_live else ""), icon="PLAY" if st and st.fps else "PAUSE")
         running = stream_running()
+        row.prop(u, "show_preview", text="", icon="IMAGE_DATA")
         sub = row.row(align=True)
         sub.operator("kinect_retarget.usb_preview", text="Stop" if running else "Stream Depth",
                      icon="PAUSE" if running else "PLAY", depress=running)

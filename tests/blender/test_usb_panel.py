@@ -310,6 +310,8 @@ def test_panel_shows_devices_status_tilt_and_preview(registered, monkeypatch, fa
     assert ("prop", "tilt") in log and ("operator", "kinect_retarget.usb_tilt") in log
     assert ("prop", "simulate") in log and ("operator", "kinect_retarget.usb_refresh") in log
     assert any(kind == "icon" for kind, _ in log)
+    registered.kinect_retarget_usb.show_preview = False
+    assert not any(kind == "icon" for kind, _ in _draw(bpy.context))
     usb_panel.stop_stream()
     # a 1473 without its audio firmware: the panel says why tilt cannot work
     emu = EmulatedKinect(fakenect_frames[:1], model="1473")
