@@ -18,7 +18,7 @@ sys.path.insert(0, str(REPO))
 
 from kinect_retarget.core.skeletons import KINECT_V1, KINECT_V2, V1_FROM_V2  # noqa: E402
 from kinect_retarget.core.take import Take  # noqa: E402
-from kinect_retarget.lift.bones import lengths_from_height, lengths_from_take, standing_height  # noqa: E402
+from kinect_retarget.lift.bones import lengths_from_take, standing_height  # noqa: E402
 from kinect_retarget.lift.camera import Camera, view_points  # noqa: E402
 from kinect_retarget.lift.evaluation import (mpjpe, procrustes_align, root_relative,  # noqa: E402
                                              sign_flip_fraction, tracks_from_take)
@@ -51,8 +51,10 @@ def mocap_take(path: Path, rate: float = 30.0, max_s: float | None = None) -> Ta
     return take.slice(frames)
 
 
-def evaluate(truth: np.ndarray, tracks: Tracks2D, lengths: np.ndarray, method: dict) -> dict:
-    st = LiftSettings(lengths=lengths, focal_px=FOCAL if method["focal"] else None,
+def evaluate(truth: np.ndarray, tracks: Tracks2D, lengths: np.ndarray | float, method: dict) -> dict:
+    """lengths: calibrated (J,) metres, or a height in metres (anthropometric, self-calibrated)."""
+    size = dict(height_m=float(lengths)) if np.ndim(lengths) == 0 else dict(lengths=lengths)
+    st = LiftSettings(**size, focal_px=FOCAL if method["focal"] else None,
                       signs=method["signs"], scale=method["scale"])
     t0 = time.perf_counter()
     res = lift(tracks, st)
@@ -72,8 +74,8 @@ def bench_mocap(files: list[str], noise_px: float, max_s: float | None, anthropo
     for name in files:
         take = mocap_take(DATA / "mocap_bvh" / name, max_s=max_s)
         lengths = lengths_from_take(take)
-        if anthropometric:
-            lengths = lengths_from_height(standing_height(lengths))
+        if anthropometric:  # only the performer's height is known
+            lengths = standing_height(lengths)
         pivot = take.positions[:, 0].mean(axis=0)
         for az, el in VIEWS:
             truth = view_points(take.positions, az, el, 4.5, pivot)
@@ -105,10 +107,10 @@ def bench_kinectron(noise_px: float = 0.0) -> None:
     ok = take.states[:, idx] > 0
     tracks = Tracks2D(uv, ok.astype(float), take.times, kinectron_json.COLOR_SIZE, source="kinectron")
     v1 = Take(KINECT_V1, truth, take.states[:, idx], take.times, take.rate)
-    for label, lengths in (("calibrated lengths", lengths_from_take(v1)),
-                           ("anthropometric (height 1.70 m)", lengths_from_height(1.70))):
+    for label, size in (("calibrated lengths", dict(lengths=lengths_from_take(v1))),
+                        ("height 1.70 m (anthropometric)", dict(height_m=1.70))):
         for focal in (1062.0, None):
-            res = lift(tracks, LiftSettings(lengths=lengths, focal_px=focal, principal_point=principal))
+            res = lift(tracks, LiftSettings(**size, focal_px=focal, principal_point=principal))
             pred = res.take.positions
             m = ok.all(axis=1)
             print(f"  kinectron, {label}, focal {'1062 px' if focal else 'unknown'}: PA-MPJPE "
@@ -128,7 +130,7 @@ def main() -> None:
     print(f"CMU mocap -> {IMAGE[0]}x{IMAGE[1]} camera, f {FOCAL:.0f} px, 4.5 m, noise {args.noise} px, 30 fps")
     print(" bone lengths calibrated from the take:")
     bench_mocap(files, args.noise, max_s, anthropometric=False)
-    print(" bone lengths from height only (anthropometric ratios):")
+    print(" bone lengths from the height only (anthropometric ratios):")
     bench_mocap(files, args.noise, max_s, anthropometric=True)
     print("Kinectron real 2D/3D pairs:")
     bench_kinectron()

@@ -144,3 +144,4 @@ def test_hips_never_visible_is_a_clear_error(walk):
         tracks.confidence[:, KINECT_V1.index(name)] = 0
     with pytest.raises(LiftError, match="hips .* are never visible"):
         lift(tracks, LiftSettings(focal_px=FOCAL))
+
