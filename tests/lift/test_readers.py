@@ -152,3 +152,21 @@ def test_coco_results_list_and_malformed(tmp_path, projected):
     (tmp_path / "other.json").write_text('{"foo": 1}')
     with pytest.raises(LiftError, match="not COCO keypoints"):
         read_2d(tmp_path / "other.json", "coco")
+
+
+def test_cli_lift_with_calibration_take(tmp_path, projected, shared_data):
+    from kinect_retarget.cli import main
+    from kinect_retarget.lift.bones import lengths_from_take
+    from kinect_retarget.takes import load_take
+    truth, uv = projected
+    (tmp_path / "kp").mkdir()
+    folder = openpose_folder(tmp_path / "kp", uv)
+    calib = shared_data / "mocap_bvh" / "131_02.bvh"
+    out = tmp_path / "lifted.krtake"
+    assert main(["lift", str(folder), "--out", str(out), "--calibrate", str(calib), "--focal", "1000",
+                 "--image-size", "1280", "720"]) == 0
+    take = load_take(out)
+    want = lengths_from_take(load_take(calib))
+    knee = J("KneeLeft")
+    assert lengths_from_take(take)[knee] == pytest.approx(want[knee], rel=0.02)
+    assert take.metadata["focal_known"] is True
