@@ -31,6 +31,7 @@ from .preferences import get_preferences
 from .properties import ensure_defaults, target_armature
 from .rig_reader import target_rig_from_object
 
+usb_source_factory = None  # set by the USB panel (usb_panel.py): simulated Kinect, device freed from its preview
 TIMER_INTERVAL = 1 / 120  # pump often: latency is arrival -> applied, and an empty pump costs microseconds
 
 _controller: "LiveController | None" = None
@@ -298,6 +299,8 @@ def make_source(settings, prefs):
     if settings.source == "OSC":
         host = "0.0.0.0" if prefs is not None and prefs.osc_listen_all else "127.0.0.1"
         return OscReceiver(settings.osc_port, host=host), f"OSC port {settings.osc_port}"
+    if usb_source_factory is not None:
+        return usb_source_factory(settings, prefs)
     return UsbKinectSource(), "USB Kinect"
 
 

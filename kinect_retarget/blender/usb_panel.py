@@ -51,7 +51,6 @@ class _Runtime:
         self.previews = None                        # bpy.utils.previews collection
         self.preview_kind = ""                      # "skeleton", "depth" or ""
         self.preview_frame = None                   # identity of the frame last shown
-        self.make_source = None                     # live.make_source before we wrapped it
 
 
 _rt = _Runtime()
@@ -185,7 +184,7 @@ def _live_producer():
     """The live session's skeleton producer when live runs on the USB Kinect, else None."""
     c = live.controller()
     src = c.session.source if c is not None else None
-    return getattr(src, "_producer", None) if isinstance(src, UsbKinectSource) else None
+    return src.producer if isinstance(src, UsbKinectSource) else None
 
 
 def live_uses_usb() -> bool:
@@ -302,10 +301,9 @@ def _redraw() -> None:
 
 
 # -- live on the USB Kinect ------------------------------------------------------------------------------------
-def _make_source(settings, prefs):
-    """live.make_source, plus the simulated Kinect, and the device freed from the panel's own stream."""
-    if settings.source != "USB":
-        return _rt.make_source(settings, prefs)
+def _make_usb_source(settings, prefs):
+    """The USB source for live (live.usb_source_factory): the simulated Kinect when chosen, and the device
+    freed from the panel's own preview stream first."""
     stop_stream()
     usb = getattr(settings.id_data, "kinect_retarget_usb", None)
     if usb is not None and usb.simulate:
@@ -315,7 +313,7 @@ def _make_source(settings, prefs):
             raise SourceError(f"USB Kinect: {reason}")
         source, label = UsbKinectSource(factory=lambda: factory(source=backend)), "simulated USB Kinect"
     else:
-        source, label = _rt.make_source(settings, prefs)
+        source, label = UsbKinectSource(), "USB Kinect"
     ensure_timer()
     return source, label
 
@@ -547,8 +545,7 @@ class KINECT_RETARGET_PT_usb(bpy.types.Panel):
 def register_extra() -> None:
     bpy.types.Scene.kinect_retarget_usb = bpy.props.PointerProperty(type=KinectRetargetUsbSettings)
     _rt.previews = bpy.utils.previews.new()
-    if _rt.make_source is None:
-        _rt.make_source, live.make_source = live.make_source, _make_source
+    live.usb_source_factory = _make_usb_source
 
 
 def unregister_extra() -> None:
@@ -561,8 +558,7 @@ def unregister_extra() -> None:
         if thread is not None:
             thread.join(THREAD_JOIN_S)   # short ones; a first render cannot be interrupted (it touches no bpy)
     _rt.discovery = _rt.sim_thread = _rt.discovery_result = None
-    if _rt.make_source is not None:
-        live.make_source, _rt.make_source = _rt.make_source, None
+    live.usb_source_factory = None
     if _rt.previews is not None:
         bpy.utils.previews.remove(_rt.previews)
         _rt.previews = None

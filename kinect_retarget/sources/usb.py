@@ -55,6 +55,11 @@ class UsbKinectSource(FrameSource):
             skeleton = KINECT_V1  # the Kinect v1 joint set, which a USB Kinect v1 tracker reports
         super().__init__(skeleton, getattr(producer, "rate", 30.0))
 
+
+    @property
+    def producer(self):
+        """The skeleton producer while streaming (the sidebar's preview reads its depth and fit)."""
+        return self._producer
     def describe(self) -> str:
         return "USB Kinect"
 

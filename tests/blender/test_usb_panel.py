@@ -325,8 +325,7 @@ def test_panel_shows_devices_status_tilt_and_preview(registered, monkeypatch, fa
 
 
 def test_unregister_leaves_no_timer_stream_thread_or_hook(registered):
-    original = usb_panel._rt.make_source
-    assert live.make_source is usb_panel._make_source
+    assert live.usb_source_factory is usb_panel._make_usb_source
     _simulate(registered)
     bpy.ops.kinect_retarget.usb_preview()
     _pump_until(lambda: usb_panel.stream_status().frames >= 1)
@@ -337,7 +336,7 @@ def test_unregister_leaves_no_timer_stream_thread_or_hook(registered):
     try:
         assert not bpy.app.timers.is_registered(usb_panel.update_preview)
         assert not stream.running and not _our_threads()
-        assert live.make_source is original
+        assert live.usb_source_factory is None
         assert usb_panel.IMAGE_NAME not in bpy.data.images and usb_panel._rt.previews is None
         assert not hasattr(bpy.types.Scene, "kinect_retarget_usb")
     finally:
