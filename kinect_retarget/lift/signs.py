@@ -188,7 +188,7 @@ def choose_signs(lines: JointLines, lengths: np.ndarray, root: np.ndarray, times
         limb_pos.append(lp - anchor[:, :, None, None, :])
         limb_un.append(_limb_unary(g, limb_pos[-1], left, fwd, priors))        # (F, St, Sl)
     unary = _torso_unary(tp - root[:, None, None, :], left, fwd, travel, priors)
-    unary = unary + sum(u.min(axis=2) for u in limb_un)
+    unary = unary + sum(u.min(axis=2) for u in limb_un)  # each limb's best cost under each torso pattern
     unary[breaks] = 0.0
     rel_z = tp[..., 2] - root[:, None, None, 2]
     torso_state = _solve(unary, _temporal(rel_z, times, priors, breaks), method)
