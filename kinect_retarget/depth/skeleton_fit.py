@@ -293,9 +293,13 @@ def _carry(prev, s, end, tip, root_pos, axis, pos, root):
 
 
 def _assign_sides(found, prev, prev_states, tip, lat, centre) -> dict:
-    """Give each found extremity a side: by continuity with the previous frame, else by body side."""
+    """Give each found extremity a side: feet well apart by body side (feet do not cross), otherwise by
+    continuity with the previous frame, else by body side."""
     if not found:
         return {}
+    if tip == "Foot" and len(found) == 2 and found[0][4] * found[1][4] < 0 \
+            and abs(found[0][4] - found[1][4]) > 0.25:
+        return dict(zip(SIDES, found if found[0][4] > 0 else found[::-1]))
     have_prev = prev is not None and prev_states is not None and all(
         prev_states[J[f"{tip}{s}"]] != NOT_TRACKED for s in SIDES)
     if len(found) == 2:
