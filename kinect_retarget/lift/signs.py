@@ -64,6 +64,7 @@ class SignPriors:
     thigh_adduction: float = 20.0
     foot_tolerance: float = 0.2      # how far forward (cosine) a foot should point before it is free
     wrist_behind_back: float = 4.0
+    arm_into_chest: float = 10.0
     shoulder_hip_twist: float = 6.0
     trunk_lean_back: float = 6.0
     head_back: float = 2.0
@@ -156,6 +157,10 @@ def _limb_unary(group: SignGroup, lp: np.ndarray, left: np.ndarray, fwd: np.ndar
         cost = pri.elbow_hyperextension * np.maximum(0.0, flex - pri.elbow_tolerance) ** 2 * 10
         cost += pri.hand_continues_forearm * np.maximum(0.0, -np.sum(_unit(tip) * _unit(lower), axis=-1)) ** 2
         cost += pri.wrist_behind_back * np.maximum(0.0, -np.sum(b * fwd, axis=-1) - 0.3) ** 2 * 10
+        # a hanging upper arm cannot point into the chest
+        inward = np.sum(_unit(upper) * (-left if group.name.endswith("Left") else left), axis=-1)
+        down = -_unit(upper)[..., 1]
+        cost = cost + pri.arm_into_chest * np.maximum(0.0, inward - 0.3) ** 2 * np.maximum(down, 0.0) * 10
     return cost
 
 
