@@ -21,12 +21,14 @@ UPPER_ARM = (0.25, 0.32)  # arm rings that give the upper arm's axis (shoulder a
 HAND_AT = (0.047, 0.5)   # the palm: half-way from the wrist to the ring across the finger roots
 LEG = {"FootLeft": 0.075, "AnkleLeft": 0.125, "KneeLeft": 0.31}
 PELVIS_AT = 0.44         # head field: a cross-section of the pelvis just above the crotch
-HIP_HALF_WIDTH = 0.056   # hip joints: this far to each side of the hip centre
+HIP_HALF_WIDTH = 0.056   # hip joints: this far to each side of the hip centre (only if a thigh has no axis)
+THIGH = (0.36, 0.46)     # leg rings that give the thigh's axis: knee (0.31) to just below the crotch
 HIP_DROP = 0.01          # ... and this far below it along the trunk
 TORSO = {"ShoulderCenter": 0.19, "HipCenter": 0.48}  # head field, inside the trunk
 SPINE_AT = 0.42          # Spine: this far from the hip centre to the shoulder centre (a trunk ring
                          # there is pulled toward the belly)
 HEAD_DOWN = 0.30         # Head joint: this far from the top toward the neck base
+HEAD_BACK = 0.25         # ... and this far from the back of the skull to the face (measured at rest)
 
 
 def vertex_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -69,6 +71,17 @@ def _cross_section_axis(vertices, field, g, width, mask, normal, area) -> np.nda
     return np.linalg.eigh((p * wt[:, None]).T @ p)[1][:, -1]
 
 
+def _closest_on_line(p: np.ndarray, d: np.ndarray, q: np.ndarray, e: np.ndarray,
+                     fallback: np.ndarray) -> np.ndarray:
+    """The point of the line p + s d nearest to the line q + t e (`fallback` when they are parallel)."""
+    w = p - q
+    b = d @ e
+    den = (d @ d) * (e @ e) - b * b
+    if den < 1e-9 * (d @ d) * (e @ e):
+        return fallback
+    return p + d * ((b * (e @ w) - (e @ e) * (d @ w)) / den)
+
+
 def body_length(fp: FeaturePoints) -> float:
     """Geodesic head-top-to-feet length L, the pose-independent size every fraction refers to."""
     return float(fp.distances[0, fp.vertices[3:5]].mean())
@@ -108,26 +121,40 @@ def kinect_joints(vertices: np.ndarray, faces: np.ndarray, fp: FeaturePoints, se
     for name, t in TORSO.items():
         out[idx(name)] = ring(head_f, t * size, in_trunk)
 
-    out[idx("Spine")] = out[idx("HipCenter")] + SPINE_AT * (out[idx("ShoulderCenter")] - out[idx("HipCenter")])
     top = vertices[fp.vertices[0]]
     neck = out[idx("ShoulderCenter")]
     head = top + HEAD_DOWN * (neck - top)
-    # Centre it front-to-back on the skull: the middle of a thin slice of the head at that height.
-    level = (vertices - head) @ fp.up
-    slab = (head_f < TORSO["ShoulderCenter"] * size) & (np.abs(level) < 0.02 * height)
+    # Front to back, the joint sits on the head's pivot line, a quarter of the skull's depth from the back
+    # (the face and nose make the rest). The slice is cut across the head's own axis (neck to crown), so a
+    # bowed or tilted head is measured along its own depth, not the body's.
+    axis = top - neck
+    axis /= max(np.linalg.norm(axis), 1e-12)
+    front = fp.front - axis * (fp.front @ axis)
+    front /= max(np.linalg.norm(front), 1e-12)
+    slab = (head_f < TORSO["ShoulderCenter"] * size) & (np.abs((vertices - head) @ axis) < 0.02 * height)
     if slab.any():
-        depth = vertices[slab] @ fp.front
-        head += fp.front * ((depth.min() + depth.max()) / 2 - head @ fp.front)
+        depth = vertices[slab] @ front
+        head += front * (depth.min() + HEAD_BACK * (depth.max() - depth.min()) - head @ front)
     out[idx("Head")] = head
-    # Hips: just below the hip centre, half a pelvis width to each side along the pelvis's own left-right
-    # axis (the long axis of the trunk's cross-section just above the crotch). The thighs' own rings do
-    # not give it: a flexed or spread leg drags them forward, back or outward.
+    # Hips (§4.2, automatically): each hip joint lies on its thigh's axis, the line fitted to the centroids
+    # of the upper leg's cross-sections, where that axis passes closest to the pelvis's left-right line
+    # (just below the hip centre, along the long axis of the trunk's cross-section above the crotch). The
+    # thigh gives the joint's spacing and front-back place, the pelvis its height; a spread, flexed or
+    # crossed leg carries its axis with it.
     hip_centre = out[idx("HipCenter")]
     trunk = neck - hip_centre
     trunk /= max(np.linalg.norm(trunk), 1e-12)
     lateral = _cross_section_axis(vertices, head_f, PELVIS_AT * size, 6 * width, in_trunk, trunk, area)
     lateral *= np.sign(lateral @ fp.left) or 1.0
     below = hip_centre - HIP_DROP * size * trunk
-    out[idx("HipLeft")] = below + HIP_HALF_WIDTH * size * lateral
-    out[idx("HipRight")] = below - HIP_HALF_WIDTH * size * lateral
+    for side, s_foot, sign in (("Left", 3, 1.0), ("Right", 4, -1.0)):
+        f = fp.distances[s_foot]
+        rings = np.array([ring(f, t * size) for t in np.linspace(*THIGH, 8)])
+        out[idx("Hip" + side)] = _closest_on_line(rings.mean(axis=0), _axis(rings), below, lateral,
+                                                  below + sign * HIP_HALF_WIDTH * size * lateral)
+    # The hip centre is midway between the hips across the pelvis: the trunk's ring there leans toward a
+    # raised or spread leg.
+    mid = 0.5 * (out[idx("HipLeft")] + out[idx("HipRight")])
+    out[idx("HipCenter")] = hip_centre + lateral * ((mid - hip_centre) @ lateral)
+    out[idx("Spine")] = out[idx("HipCenter")] + SPINE_AT * (neck - out[idx("HipCenter")])
     return out
