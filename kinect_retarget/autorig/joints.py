@@ -3,8 +3,8 @@
 Each joint is the centroid of an iso-geodesic ring around a limb (or the trunk), at a fixed fraction of the
 body's geodesic length; the fractions are human proportions, measured on MakeHuman's base mesh and checked
 on its posed versions (benchmarks/bench_autorig.py). The paper's hand-stepped shoulder/ankle adjustment
-(§4.2) becomes automatic: the shoulder is moved onto the upper arm's axis; the hips are placed from the
-pelvis's cross-section rather than from the tilted thigh rings.
+(§4.2) becomes automatic: the shoulder is moved onto the upper arm's axis; each hip is where its thigh's
+axis meets the pelvis's left-right line; the hip centre is the centroid of the pelvis level set.
 """
 from __future__ import annotations
 
@@ -20,11 +20,13 @@ ARM = {"WristLeft": 0.105, "ElbowLeft": 0.215, "ShoulderLeft": 0.335}
 UPPER_ARM = (0.25, 0.32)  # arm rings that give the upper arm's axis (shoulder adjustment, §4.2)
 HAND_AT = (0.047, 0.5)   # the palm: half-way from the wrist to the ring across the finger roots
 LEG = {"FootLeft": 0.075, "AnkleLeft": 0.125, "KneeLeft": 0.31}
-PELVIS_AT = 0.44         # head field: a cross-section of the pelvis just above the crotch
-HIP_HALF_WIDTH = 0.056   # hip joints: this far to each side of the hip centre (only if a thigh has no axis)
+PELVIS_AT = 0.44         # head field: the pelvis starts here (its cross-section; below it, its level set)
+HIP_DROP = 0.01          # the pelvis's left-right line through the hips: this far below the hip centre
 THIGH = (0.36, 0.46)     # leg rings that give the thigh's axis: knee (0.31) to just below the crotch
-HIP_DROP = 0.01          # ... and this far below it along the trunk
-TORSO = {"ShoulderCenter": 0.19, "HipCenter": 0.48}  # head field, inside the trunk
+HIP_HALF_WIDTH = 0.056   # hips this far to each side of the hip centre, only if a thigh axis is parallel
+                         # to the pelvis line (no crossing point)
+TORSO = {"ShoulderCenter": 0.19, "HipCenter": 0.48}  # head field, inside the trunk (HipCenter: only
+                                                     # when the trunk has nothing below PELVIS_AT)
 SPINE_AT = 0.42          # Spine: this far from the hip centre to the shoulder centre (a trunk ring
                          # there is pulled toward the belly)
 HEAD_DOWN = 0.30         # Head joint: this far from the top toward the neck base
@@ -141,7 +143,11 @@ def kinect_joints(vertices: np.ndarray, faces: np.ndarray, fp: FeaturePoints, se
     # (just below the hip centre, along the long axis of the trunk's cross-section above the crotch). The
     # thigh gives the joint's spacing and front-back place, the pelvis its height; a spread, flexed or
     # crossed leg carries its axis with it.
-    hip_centre = out[idx("HipCenter")]
+    # The pelvis: the area centroid of the trunk below PELVIS_AT, down to where the legs begin (the
+    # paper's level-set centroid rather than one ring, which a raised or split leg drags forward).
+    pelvis = in_trunk & (head_f > PELVIS_AT * size)
+    hip_centre = (np.average(vertices[pelvis], axis=0, weights=area[pelvis] + 1e-30) if pelvis.any()
+                  else out[idx("HipCenter")])
     trunk = neck - hip_centre
     trunk /= max(np.linalg.norm(trunk), 1e-12)
     lateral = _cross_section_axis(vertices, head_f, PELVIS_AT * size, 6 * width, in_trunk, trunk, area)
