@@ -199,9 +199,14 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
         assign = _assign_sides(found, prev, prev_states, tip, lat, centre)
         for s in SIDES:
             e = assign.get(s)
+            a = pos[J[f"{root}{s}"]]
+            l1, l2 = r1 * H, r2 * H
             if (e is not None and prev is not None and prev_states is not None
                     and prev_states[J[f"{tip}{s}"]] == TRACKED and np.linalg.norm(e[1] - prev[J[f"{tip}{s}"]]) > 0.45):
                 e = None  # a hand or foot does not jump 45 cm in one frame: another body part's extremity
+            if e is not None and root == "Shoulder" and \
+                    np.linalg.norm(e[1] - a) > 1.2 * (l1 + l2 + bm.HAND * H):
+                e = None  # out of the arm's reach: a knee or foot taken for a hand
             a = pos[J[f"{root}{s}"]]
             l1, l2 = r1 * H, r2 * H
             if e is not None:
