@@ -6,7 +6,8 @@ spine, shoulder girdle, head) and each limb (3 bits). A group's state per frame 
 patterns; we choose the whole take's states by dynamic programming (Viterbi) with
 * temporal continuity: joints do not jump in depth between frames (a flip only costs nothing where the bone
   lies in the image plane, which is where a real crossing happens);
-* joint limits: knees do not bend forward, elbows not backward, a thigh swings only a little inward,
+* joint limits: knees do not bend forward, elbows not backward, a thigh swings only a little inward, a
+  hanging upper arm does not point into the chest,
   hands continue the forearm, feet point forward, shoulders and hips do not twist apart by more than a
   spine can;
 * priors: the trunk does not lean far backward, a walking body faces where it goes.
