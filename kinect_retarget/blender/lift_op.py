@@ -11,6 +11,7 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, StringProperty
 
+from ..core.pipeline import RetargetSettings
 from ..core.presets import PRESET_NAMES
 from ..core.take import TakeError
 from ..lift import LiftError, LiftSettings, lift
@@ -165,7 +166,10 @@ def lift_clip_and_bake(context, clip, armature: str, preset: str = "auto", heigh
         obj = new_generated_rig(context.scene, res.take, f"{clip.name}_Rig")
     else:
         obj = context.scene.objects[armature]
-    out = bake_take(obj, res.take, preset=preset, report=report)
+    # keys line up with the footage: the first tracked clip frame lands on its scene frame, at the clip rate
+    first = int(tracks.frame_numbers[0]) + clip.frame_start - 1
+    settings = RetargetSettings(fps=res.take.rate, frame_start=first)
+    out = bake_take(obj, res.take, preset=preset, settings=settings, report=report)
     report({"INFO"}, f"Lifted {res.take.frame_count} frames of clip '{clip.name}' "
                      f"({'focal ' + format(focal, '.0f') + ' px' if focal else 'orthographic'})")
     return out

@@ -41,7 +41,7 @@ def walk_2d(shared_data):
     return pos, Camera.for_image(W, H, FOCAL).project(pos)
 
 
-def _clip(bpy, tmp_path, uv, names=TRACK_NAMES):
+def _clip(bpy, tmp_path, uv, names=TRACK_NAMES, first=1):
     _png(str(tmp_path / "plate.png"), W, H)
     clip = bpy.data.movieclips.load(str(tmp_path / "plate.png"))
     cam = clip.tracking.camera
@@ -49,13 +49,13 @@ def _clip(bpy, tmp_path, uv, names=TRACK_NAMES):
     cam.focal_length = FOCAL * 36.0 / W
     for joint, name in names.items():
         j = KINECT_V1.index(joint)
-        track = clip.tracking.tracks.new(name=name, frame=1)
+        track = clip.tracking.tracks.new(name=name, frame=first)
         for f in range(len(uv)):
             co = (uv[f, j, 0] / W, 1.0 - uv[f, j, 1] / H)
             if f == 0:
                 track.markers[0].co = co
             else:
-                track.markers.insert_frame(f + 1, co=co)
+                track.markers.insert_frame(f + first, co=co)
     bpy.context.scene.active_clip = clip
     bpy.context.scene.render.fps = 30
     return clip
@@ -84,7 +84,7 @@ def test_lift_clip_operator_bakes_a_rig(registered, tmp_path, walk_2d):
     rig = rigs[0]
     action = rig.animation_data.action
     assert action is not None
-    assert tuple(action.frame_range) == pytest.approx((1, len(uv)), abs=1)
+    assert tuple(action.frame_range) == pytest.approx((1, len(uv)), abs=1)  # keys on the clip's frames
     from kinect_retarget.takes import load_take
     take = load_take(take_path)
     # the baked rig's shin points where the lifted (and the real) shin points
@@ -99,6 +99,15 @@ def test_lift_clip_operator_bakes_a_rig(registered, tmp_path, walk_2d):
         cos_lift = shin @ lifted / np.linalg.norm(shin) / np.linalg.norm(lifted)
         cos_real = shin @ real / np.linalg.norm(shin) / np.linalg.norm(real)
         assert cos_lift > np.cos(np.radians(10)) and cos_real > np.cos(np.radians(25))
+
+
+def test_keys_line_up_with_the_tracked_clip_frames(registered, tmp_path, walk_2d):
+    bpy = registered
+    pos, uv = walk_2d
+    _clip(bpy, tmp_path, uv[:20], first=31)
+    assert bpy.ops.kinect_retarget.lift_clip(armature="__new__") == {"FINISHED"}
+    rig = next(o for o in bpy.data.objects if o.type == "ARMATURE")
+    assert tuple(rig.animation_data.action.frame_range) == pytest.approx((31, 50), abs=0.5)
 
 
 def test_unknown_track_names_are_a_clear_error(registered, tmp_path, walk_2d):
