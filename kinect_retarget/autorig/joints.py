@@ -31,6 +31,7 @@ SPINE_AT = 0.42          # Spine: this far from the hip centre to the shoulder c
                          # there is pulled toward the belly)
 HEAD_DOWN = 0.30         # Head joint: this far from the top toward the neck base
 HEAD_BACK = 0.25         # ... and this far from the back of the skull to the face (measured at rest)
+SPINE_BACK = 0.25        # Spine: this far from the back to the belly (measured at rest: 0.26)
 
 
 def vertex_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -71,6 +72,20 @@ def _cross_section_axis(vertices, field, g, width, mask, normal, area) -> np.nda
     p = vertices[band] - np.average(vertices[band], axis=0, weights=wt)
     p -= np.outer(p @ normal, normal)
     return np.linalg.eigh((p * wt[:, None]).T @ p)[1][:, -1]
+
+
+def _from_back(vertices: np.ndarray, mask: np.ndarray, point: np.ndarray, axis: np.ndarray,
+               front: np.ndarray, half_thickness: float, fraction: float) -> np.ndarray:
+    """`point` moved along the front direction (made square to `axis`) to `fraction` of the body's depth
+    from the back, the depth measured on the slice of the masked vertices through `point` across `axis`."""
+    axis = axis / max(np.linalg.norm(axis), 1e-12)
+    front = front - axis * (front @ axis)
+    front /= max(np.linalg.norm(front), 1e-12)
+    slab = mask & (np.abs((vertices - point) @ axis) < half_thickness)
+    if not slab.any():
+        return point
+    depth = vertices[slab] @ front
+    return point + front * (depth.min() + fraction * (depth.max() - depth.min()) - point @ front)
 
 
 def _closest_on_line(p: np.ndarray, d: np.ndarray, q: np.ndarray, e: np.ndarray,
@@ -129,20 +144,9 @@ def kinect_joints(vertices: np.ndarray, faces: np.ndarray, fp: FeaturePoints, se
     # Front to back, the joint sits on the head's pivot line, a quarter of the skull's depth from the back
     # (the face and nose make the rest). The slice is cut across the head's own axis (neck to crown), so a
     # bowed or tilted head is measured along its own depth, not the body's.
-    axis = top - neck
-    axis /= max(np.linalg.norm(axis), 1e-12)
-    front = fp.front - axis * (fp.front @ axis)
-    front /= max(np.linalg.norm(front), 1e-12)
-    slab = (head_f < TORSO["ShoulderCenter"] * size) & (np.abs((vertices - head) @ axis) < 0.02 * height)
-    if slab.any():
-        depth = vertices[slab] @ front
-        head += front * (depth.min() + HEAD_BACK * (depth.max() - depth.min()) - head @ front)
+    head = _from_back(vertices, head_f < TORSO["ShoulderCenter"] * size, head, top - neck, fp.front,
+                      0.02 * height, HEAD_BACK)
     out[idx("Head")] = head
-    # Hips (§4.2, automatically): each hip joint lies on its thigh's axis, the line fitted to the centroids
-    # of the upper leg's cross-sections, where that axis passes closest to the pelvis's left-right line
-    # (just below the hip centre, along the long axis of the trunk's cross-section above the crotch). The
-    # thigh gives the joint's spacing and front-back place, the pelvis its height; a spread, flexed or
-    # crossed leg carries its axis with it.
     # The pelvis: the area centroid of the trunk below PELVIS_AT, down to where the legs begin (the
     # paper's level-set centroid rather than one ring, which a raised or split leg drags forward).
     pelvis = in_trunk & (head_f > PELVIS_AT * size)
@@ -153,6 +157,11 @@ def kinect_joints(vertices: np.ndarray, faces: np.ndarray, fp: FeaturePoints, se
     lateral = _cross_section_axis(vertices, head_f, PELVIS_AT * size, 6 * width, in_trunk, trunk, area)
     lateral *= np.sign(lateral @ fp.left) or 1.0
     below = hip_centre - HIP_DROP * size * trunk
+    # Hips (§4.2, automatically): each hip joint lies on its thigh's axis, the line fitted to the centroids
+    # of the upper leg's cross-sections, where that axis passes closest to the pelvis's left-right line
+    # (just below the hip centre, along the long axis of the trunk's cross-section above the crotch). The
+    # thigh gives the joint's spacing and front-back place, the pelvis its height; a spread, flexed or
+    # crossed leg carries its axis with it.
     for side, s_foot, sign in (("Left", 3, 1.0), ("Right", 4, -1.0)):
         f = fp.distances[s_foot]
         rings = np.array([ring(f, t * size) for t in np.linspace(*THIGH, 8)])
@@ -162,5 +171,9 @@ def kinect_joints(vertices: np.ndarray, faces: np.ndarray, fp: FeaturePoints, se
     # raised or spread leg.
     mid = 0.5 * (out[idx("HipLeft")] + out[idx("HipRight")])
     out[idx("HipCenter")] = hip_centre + lateral * ((mid - hip_centre) @ lateral)
-    out[idx("Spine")] = out[idx("HipCenter")] + SPINE_AT * (neck - out[idx("HipCenter")])
+    # Spine: at its height on the trunk's chord, then moved front to back to where the backbone runs, a
+    # quarter of the trunk's depth from the back (the chord of an arched or bowed back leaves the body).
+    spine = out[idx("HipCenter")] + SPINE_AT * (neck - out[idx("HipCenter")])
+    out[idx("Spine")] = _from_back(vertices, in_trunk, spine, neck - out[idx("HipCenter")], fp.front,
+                                   0.02 * height, SPINE_BACK)
     return out
