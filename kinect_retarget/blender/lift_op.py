@@ -175,8 +175,85 @@ def lift_clip_and_bake(context, clip, armature: str, preset: str = "auto", heigh
     return out
 
 
+def sequence_files(clip: bpy.types.MovieClip) -> list[str]:
+    """The image files of an image-sequence clip, clip frame 1 first."""
+    import re
+
+    from ..lift.frames import list_frames
+    path = bpy.path.abspath(clip.filepath)
+    stem = re.sub(r"\d+(\.\w+)$", "", os.path.basename(path))
+    files = [f for f in list_frames(os.path.dirname(path)) if os.path.basename(f).startswith(stem)]
+    return files[clip.frame_offset:]
+
+
+def track_clip_joints(clip: bpy.types.MovieClip, start: int, end: int | None = None,
+                      settings=None, report=lambda level, msg: None) -> dict:
+    """Paper 004's tracker on an image-sequence clip: every joint-named track with a marker on clip frame
+    `start` is followed to `end` (default: the clip's last frame); its markers are written as it goes,
+    muted where the joint is lost."""
+    from ..lift.clip_naming import joint_for_track
+    from ..lift.tracker import JointTracker, TrackerSettings
+
+    if clip.source != "SEQUENCE":
+        raise LiftError(f"clip '{clip.name}': the joint tracker reads image sequences (this clip is a "
+                        f"{clip.source.lower()}); render the footage to images, or track with Blender's tracker")
+    files = sequence_files(clip)
+    end = min(end or len(files), len(files))
+    w, h = clip.size
+    tracks = {}
+    for obj in clip.tracking.objects:
+        for t in obj.tracks:
+            m = t.markers.find_frame(start, exact=True)
+            if m is not None and not m.mute and joint_for_track(t.name):
+                tracks[t.name] = (t, (m.co[0] * w, (1.0 - m.co[1]) * h))
+    if not tracks:
+        raise LiftError(f"clip '{clip.name}': no joint-named track has a marker on frame {start} "
+                        f"(place one marker per joint there; see docs/lifting.md for names)")
+    first = load_image_rgb(files[start - 1])
+    tracker = JointTracker(first, {n: uv for n, (_, uv) in tracks.items()}, settings or TrackerSettings())
+    lost = 0
+    for frame in range(start + 1, end + 1):
+        r = tracker.step(load_image_rgb(files[frame - 1]))
+        for k, name in enumerate(tracker.names):
+            marker = tracks[name][0].markers.insert_frame(frame, co=(r.uv[k, 0] / w, 1.0 - r.uv[k, 1] / h))
+            marker.mute = not bool(r.found[k])
+        lost += int((~r.found).sum())
+    n = max(end - start, 1) * len(tracker.names)
+    report({"INFO"}, f"Tracked {len(tracker.names)} joints over frames {start}-{end}; lost {lost / n:.1%} "
+                     f"of joint-frames")
+    return {"joints": list(tracker.names), "frames": (start, end), "lost_fraction": lost / n}
+
+
+class KINECT_RETARGET_OT_track_clip_joints(bpy.types.Operator):
+    """Follow joint-named tracks from the current frame with paper 004's colour particle-filter tracker
+    (image-sequence clips); writes their markers"""
+
+    bl_idname = "kinect_retarget.track_clip_joints"
+    bl_label = "Track Joints (Colour Particle Filter)"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        clip = _active_clip(context)
+        if clip is None or clip.source != "SEQUENCE":
+            cls.poll_message_set("Needs an image-sequence Movie Clip with joint-named tracks")
+            return False
+        return True
+
+    def execute(self, context):
+        clip = _active_clip(context)
+        start = context.scene.frame_current - clip.frame_start + 1
+        try:
+            track_clip_joints(clip, start, report=self.report)
+        except (LiftError, ValueError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+
 def _menu(self, context):
     self.layout.separator()
+    self.layout.operator(KINECT_RETARGET_OT_track_clip_joints.bl_idname, icon="TRACKING_FORWARDS")
     self.layout.operator(KINECT_RETARGET_OT_lift_clip.bl_idname, icon="ARMATURE_DATA")
 
 
@@ -188,4 +265,4 @@ def unregister_extra() -> None:
     bpy.types.CLIP_MT_track.remove(_menu)
 
 
-CLASSES = (KINECT_RETARGET_OT_lift_clip,)
+CLASSES = (KINECT_RETARGET_OT_lift_clip, KINECT_RETARGET_OT_track_clip_joints)

@@ -55,3 +55,18 @@ def write_ppm(path: str, rgb: np.ndarray) -> None:
     with open(path, "wb") as fh:
         fh.write(b"P6\n%d %d\n255\n" % (w, h))
         fh.write(img.tobytes())
+
+
+def write_png(path: str, rgb: np.ndarray) -> None:
+    """8-bit RGB PNG (no filtering), for test sequences that Blender's clip loader can read."""
+    import struct
+    import zlib
+    img = np.clip(np.round(np.asarray(rgb)[..., :3] * 255), 0, 255).astype(np.uint8)
+    h, w = img.shape[:2]
+    raw = np.concatenate([np.zeros((h, 1), np.uint8), img.reshape(h, -1)], axis=1).tobytes()
+
+    def chunk(tag: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
+    with open(path, "wb") as fh:
+        fh.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+                 + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))

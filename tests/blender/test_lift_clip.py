@@ -186,3 +186,42 @@ def test_lift_bakes_onto_an_hanim_humanoid(bpy_empty, tmp_path, walk_2d, shared_
             got = np.array(rig.matrix_world @ pb.tail) - np.array(rig.matrix_world @ pb.head)
             real = kinect_to_blender(pos[frame - 1, KINECT_V1.index(b)] - pos[frame - 1, KINECT_V1.index(a)])
             assert got @ real / np.linalg.norm(got) / np.linalg.norm(real) > np.cos(np.radians(30)), bone
+
+
+def test_joint_tracker_writes_clip_markers(registered, tmp_path, shared_data):
+    """Paper 004's tracker inside Blender: markers on frame 1 of an image-sequence clip of a rendered
+    coloured body (real motion), followed through the clip."""
+    from kinect_retarget.lift.frames import write_png
+    from kinect_retarget.lift.render import background, render
+    bpy = registered
+    take = bvh.read(shared_data / "mocap_bvh" / "131_02.bvh")
+    pos = view_points(take.positions[::4][150:165], 80.0, 5.0, 3.5, take.positions[600, 0])
+    size, cam = (320, 240), Camera.for_image(320, 240, 300.0)
+    rng = np.random.default_rng(4)
+    bg = background(*size, rng)
+    (tmp_path / "seq").mkdir()
+    for i, p in enumerate(pos):
+        write_png(str(tmp_path / "seq" / f"body_{i + 1:04d}.png"), render(p, cam, *size, bg, rng))
+    uv = cam.project(pos)
+    clip = bpy.data.movieclips.load(str(tmp_path / "seq" / "body_0001.png"))
+    names = {"ElbowLeft": "l_elbow", "KneeRight": "r_knee", "Head": "skullbase", "HipCenter": "pelvis"}
+    for joint, name in names.items():
+        t = clip.tracking.tracks.new(name=name, frame=1)
+        j = KINECT_V1.index(joint)
+        t.markers[0].co = (uv[0, j, 0] / size[0], 1 - uv[0, j, 1] / size[1])
+    bpy.context.scene.active_clip = clip
+    bpy.context.scene.frame_current = 1
+    assert bpy.ops.kinect_retarget.track_clip_joints() == {"FINISHED"}
+    errs = []
+    for joint, name in names.items():
+        track = clip.tracking.tracks[name]
+        j = KINECT_V1.index(joint)
+        for f in range(2, len(pos) + 1):
+            m = track.markers.find_frame(f, exact=True)
+            assert m is not None
+            got = (m.co[0] * size[0], (1 - m.co[1]) * size[1])
+            errs.append(np.hypot(got[0] - uv[f - 1, j, 0], got[1] - uv[f - 1, j, 1]))
+    assert np.mean(errs) < 6.0
+    idx = [KINECT_V1.index(j) for j in names]
+    moved = np.linalg.norm(uv[1:, idx] - uv[:1, idx], axis=-1).mean()
+    assert moved > 2 * np.mean(errs), (moved, np.mean(errs))  # the joints really moved
