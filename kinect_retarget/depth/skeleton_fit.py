@@ -250,6 +250,13 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
             mid_ok = st_limb == TRACKED and proj.supported(m, bm.DEPTH_INSIDE[mid] - 0.02)
             st[J[f"{mid}{s}"]] = TRACKED if mid_ok or st_limb == TRACKED else INFERRED
             st[J[f"{end}{s}"]] = st[J[f"{tip}{s}"]] = st_limb
+    # without the head top or the shoulders the torso's place along its axis is a guess; seen more than
+    # 45 degrees from the front, shoulders and hips overlap in depth: say so instead of claiming them
+    if shift is None:
+        st[[J["HipCenter"], J["Spine"], J["ShoulderCenter"]]] = INFERRED
+    if facing @ -view < 0.7:
+        for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
+            st[J[name]] = INFERRED
     return FitResult(pos, st, lat, labels, centre, None if head is None else head[1])
 
 
