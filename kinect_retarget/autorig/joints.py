@@ -29,8 +29,8 @@ TORSO = {"ShoulderCenter": 0.19, "HipCenter": 0.48}  # head field, inside the tr
                                                      # when the trunk has nothing below PELVIS_AT)
 SPINE_AT = 0.42          # Spine: this far from the hip centre to the shoulder centre (a trunk ring
                          # there is pulled toward the belly)
-HEAD_DOWN = 0.30         # Head joint: this far from the top toward the neck base
-HEAD_BACK = 0.25         # ... and this far from the back of the skull to the face (measured at rest)
+HEAD_CAP = 0.12          # the head: the surface this close to the crown (down to the chin)
+HEAD_BACK = 0.25         # Head joint: this far from the back of the skull to the face (measured at rest)
 SPINE_BACK = 0.25        # Spine: this far from the back to the belly (measured at rest: 0.26)
 
 
@@ -138,13 +138,14 @@ def kinect_joints(vertices: np.ndarray, faces: np.ndarray, fp: FeaturePoints, se
     for name, t in TORSO.items():
         out[idx(name)] = ring(head_f, t * size, in_trunk)
 
-    top = vertices[fp.vertices[0]]
     neck = out[idx("ShoulderCenter")]
-    head = top + HEAD_DOWN * (neck - top)
-    # Front to back, the joint sits on the head's pivot line, a quarter of the skull's depth from the back
-    # (the face and nose make the rest). The slice is cut across the head's own axis (neck to crown), so a
-    # bowed or tilted head is measured along its own depth, not the body's.
-    head = _from_back(vertices, head_f < TORSO["ShoulderCenter"] * size, head, top - neck, fp.front,
+    # Head: the centroid of the head (the surface within HEAD_CAP of the crown, down to the chin), which no
+    # single vertex moves; then, front to back, onto the head's pivot line a quarter of the skull's depth
+    # from the back (the face and nose make the rest), measured across the head's own axis (neck to head)
+    # so that a bowed or tilted head is measured along its own depth, not the body's.
+    cap = head_f < HEAD_CAP * size
+    head = np.average(vertices[cap], axis=0, weights=area[cap] + 1e-30)
+    head = _from_back(vertices, head_f < TORSO["ShoulderCenter"] * size, head, head - neck, fp.front,
                       0.02 * height, HEAD_BACK)
     out[idx("Head")] = head
     # The pelvis: the area centroid of the trunk below PELVIS_AT, down to where the legs begin (the
