@@ -17,6 +17,7 @@ from .features import FeaturePoints
 # surface barely stretches when a body moves, so these hold from A-pose to T-pose to a split (the branch
 # lengths of the tree metric do not: the junctions slide with the arms).
 ARM = {"WristLeft": 0.105, "ElbowLeft": 0.215, "ShoulderLeft": 0.335}
+FOREARM = (0.11, 0.18)  # arm levels that give the forearm's centre line: wrist (0.105) to elbow
 UPPER_ARM = (0.25, 0.32)  # arm rings that give the upper arm's axis (shoulder adjustment, §4.2)
 HAND_AT = (0.047, 0.5)   # the palm: half-way from the wrist to the ring across the finger roots
 LEG = {"FootLeft": 0.075, "AnkleLeft": 0.125, "KneeLeft": 0.31}
@@ -74,6 +75,22 @@ def _cross_section_axis(vertices, field, g, width, mask, normal, area) -> np.nda
     return np.linalg.eigh((p * wt[:, None]).T @ p)[1][:, -1]
 
 
+def _level_line_at(vertices: np.ndarray, field: np.ndarray, lo: float, hi: float, at: float,
+                   area: np.ndarray, fallback: np.ndarray) -> np.ndarray:
+    """The point at geodesic level `at` of a straight limb's centre line, fitted between levels lo and hi:
+    the area-weighted linear regression of the vertex positions on their geodesic value, i.e. the line
+    through all the ring centroids at once (sampling a few rings instead makes the line jitter)."""
+    band = (field > lo) & (field < hi)
+    if band.sum() < 4:
+        return fallback
+    w = area[band] + 1e-30
+    mean_g = np.average(field[band], weights=w)
+    g = field[band] - mean_g
+    centre = np.average(vertices[band], axis=0, weights=w)
+    slope = ((vertices[band] - centre) * (w * g)[:, None]).sum(axis=0) / max((w * g * g).sum(), 1e-30)
+    return centre + slope * (at - mean_g)
+
+
 def _from_back(vertices: np.ndarray, mask: np.ndarray, point: np.ndarray, axis: np.ndarray,
                front: np.ndarray, half_thickness: float, fraction: float) -> np.ndarray:
     """`point` moved along the front direction (made square to `axis`) to `fraction` of the body's depth
@@ -129,6 +146,10 @@ def kinect_joints(vertices: np.ndarray, faces: np.ndarray, fp: FeaturePoints, se
         axis = _axis(np.array([ring(f, t * size) for t in np.linspace(*UPPER_ARM, 5)]))
         axis *= np.sign(axis @ (shoulder - elbow)) or 1.0
         out[idx("Shoulder" + side)] = elbow + axis * np.linalg.norm(shoulder - elbow)
+        # The wrist: where the forearm's straight centre line reaches the wrist's level. The ring at the
+        # wrist itself slants into the palm when the hand bends, and its centroid can leave the wrist.
+        out[idx("Wrist" + side)] = _level_line_at(vertices, f, FOREARM[0] * size, FOREARM[1] * size,
+                                                  ARM["WristLeft"] * size, area, out[idx("Wrist" + side)])
         wrist = out[idx("Wrist" + side)]
         palm = ring(f, HAND_AT[0] * size)
         out[idx("Hand" + side)] = wrist + HAND_AT[1] * (palm - wrist)
