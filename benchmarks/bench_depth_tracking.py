@@ -59,7 +59,9 @@ def cached(name: str, clip: str, frames: int, scenario: Scenario | None = None, 
 
 def run(data):
     tracker = SkeletonTracker(gravity=data["gravity"])
-    n = len(data["mm"])
+    mm, times = np.asarray(data["mm"]), np.asarray(data["times"])  # an NpzFile decompresses on every access
+    data = {"mm": mm, "times": times}
+    n = len(mm)
     pos, st = np.zeros((n, 20, 3)), np.zeros((n, 20), np.uint8)
     lat = np.zeros(n)
     for i in range(n):
