@@ -207,6 +207,9 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
             if e is not None and root == "Shoulder" and \
                     np.linalg.norm(e[1] - a) > 1.2 * (l1 + l2 + bm.HAND * H):
                 e = None  # out of the arm's reach: a knee or foot taken for a hand
+            if e is not None and root == "Shoulder" and (1.0 if s == "Left" else -1.0) * e[4] < -0.1 * H \
+                    and not (prev is not None and np.linalg.norm(e[1] - prev[J[f"{tip}{s}"]]) < 0.15):
+                e = None  # out beyond the other shoulder and not followed there: the other side's part
             a = pos[J[f"{root}{s}"]]
             l1, l2 = r1 * H, r2 * H
             if e is not None:
