@@ -225,6 +225,16 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
                 root_cell = _nearest_cell(xyz, mask, a)
                 along_limb = e[2] - (d0[root_cell] if root_cell is not None and np.isfinite(d0[root_cell]) else 0.0)
                 st_limb = TRACKED if along_limb > 0.7 * (l1 + l2) else INFERRED
+                if st_limb == INFERRED and root == "Shoulder":
+                    # not a hand (an elbow, a shoulder): look for the arm as if no extremity was found
+                    found_arm = _hanging_arm(xyz, mask, a, axis, lat, 1.0 if s == "Left" else -1.0, centre, H)
+                    if found_arm is not None:
+                        toward = _unit(a - found_arm)
+                        tip_p = found_arm + toward * 0.07 + inside(tip)
+                        end_p = tip_p + toward * bm.HAND * H
+                        mid_ls = None
+                    else:
+                        end_p, tip_p, mid_ls = _carry(prev, s, end, tip, a, axis, pos, root)
             else:
                 found_arm = _hanging_arm(xyz, mask, a, axis, lat, 1.0 if s == "Left" else -1.0, centre, H) \
                     if root == "Shoulder" else None
