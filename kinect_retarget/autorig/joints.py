@@ -1,10 +1,13 @@
 """Name the skeleton: the 20 Kinect v1 joints placed on the geodesic centre lines of the segments.
 
-Each joint is the centroid of an iso-geodesic ring around a limb (or the trunk), at a fixed fraction of the
-body's geodesic length; the fractions are human proportions, measured on MakeHuman's base mesh and checked
-on its posed versions (benchmarks/bench_autorig.py). The paper's hand-stepped shoulder/ankle adjustment
-(§4.2) becomes automatic: the shoulder is moved onto the upper arm's axis; each hip is where its thigh's
-axis meets the pelvis's left-right line; the hip centre is the centroid of the pelvis level set.
+Limb joints are centroids of iso-geodesic rings around a limb (or the trunk), at fixed fractions of the
+body's geodesic length; the fractions are human proportions, measured on MakeHuman's base mesh at rest and
+checked on its posed versions (benchmarks/bench_autorig.py). The paper's hand-stepped shoulder/ankle
+adjustment (§4.2) becomes automatic, and the trunk joints come from its geometry: the shoulder is moved onto
+the upper arm's axis and the wrist onto the forearm's centre line; each hip is where its thigh's axis meets
+the pelvis's left-right line; the hip centre is the centroid of the pelvis level set; the head is the head's
+centroid and the spine a point of the trunk's chord, each moved onto the line the skull or the backbone
+pivots on.
 """
 from __future__ import annotations
 
@@ -28,8 +31,7 @@ HIP_HALF_WIDTH = 0.056   # hips this far to each side of the hip centre, only if
                          # to the pelvis line (no crossing point)
 TORSO = {"ShoulderCenter": 0.19, "HipCenter": 0.48}  # head field, inside the trunk (HipCenter: only
                                                      # when the trunk has nothing below PELVIS_AT)
-SPINE_AT = 0.42          # Spine: this far from the hip centre to the shoulder centre (a trunk ring
-                         # there is pulled toward the belly)
+SPINE_AT = 0.42          # Spine: this far from the hip centre to the shoulder centre
 HEAD_CAP = 0.12          # the head: the surface this close to the crown (down to the chin)
 HEAD_BACK = 0.25         # Head joint: this far from the back of the skull to the face (measured at rest)
 SPINE_BACK = 0.25        # Spine: this far from the back to the belly (measured at rest: 0.26)
