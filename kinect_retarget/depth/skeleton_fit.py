@@ -255,6 +255,8 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
             else:  # no history: elbows bend backwards/outwards, knees forwards
                 pref = -view if root == "Hip" else (view + lat * (1 if s == "Left" else -1))
                 cost = cost - 0.02 * ((cands - a) @ _unit(pref))
+            if root == "Hip":  # knees only ever bend forwards: keep them off the back of the circle
+                cost = cost + 0.3 * np.maximum(0.0, -((cands - (a + end_p2) / 2) @ facing))
             m = cands[int(np.argmin(cost))]
             pos[J[f"{mid}{s}"]] = m
             shift = end_p2 - end_p  # keep the hand/foot attached when the end was pulled into reach
