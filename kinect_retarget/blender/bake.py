@@ -33,7 +33,8 @@ def _write_curves(channelbag, data_path: str, group: str, frames: np.ndarray, va
         co[:, 1] = values[:, c]
         kp.foreach_set("co", co.ravel())
         kp.foreach_set("interpolation", interp)
-        kp.handles_recalc()  # keys are written in order and unique: no sort needed, only handles
+        # no fcurve.update(): keys are written in order, unique and linear (as Blender's own bake does,
+        # bpy_extras.anim_utils.KeyframesCo.insert_keyframes_into_new_action)
 
 
 def bake_motion(obj: bpy.types.Object, motion: BakedMotion, action_name: str,

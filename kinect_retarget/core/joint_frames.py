@@ -61,18 +61,32 @@ def resolver(names: tuple[str, ...], positions: np.ndarray, joint_axis: int = -2
     return get
 
 
-def frame_from_y_hint(y: np.ndarray, hint: np.ndarray) -> np.ndarray:
-    """Frames with Y along `y` and X as close to `hint` as possible; X = Y × AB in the paper's terms."""
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a × b over the last axis, written out (np.cross is several times slower on large stacks)."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
+
+
+def frame_axes(y: np.ndarray, hint: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Unit X, Y, Z axes of the frames with Y along `y` and X as close to `hint` as possible
+    (X = Y × AB in the paper's terms)."""
     y = normalize(y)
-    x = hint - np.sum(hint * y, axis=-1, keepdims=True) * y
+    x = hint - np.einsum("...i,...i->...", hint, y)[..., None] * y
     # A hint parallel to Y leaves X undefined; pick any perpendicular so output stays finite.
-    bad = np.linalg.norm(x, axis=-1) < 1e-9
+    bad = np.einsum("...i,...i->...", x, x) < 1e-18
     if np.any(bad):
         alt = np.where(np.abs(y[..., :1]) < 0.9, np.array([1.0, 0, 0]), np.array([0, 0, 1.0]))
-        x = np.where(bad[..., None], np.cross(y, np.cross(alt, y)), x)
+        x = np.where(bad[..., None], _cross(y, _cross(alt, y)), x)
     x = normalize(x)
-    z = np.cross(x, y)
-    return np.stack([x, y, z], axis=-1)
+    return x, y, _cross(x, y)
+
+
+def frame_from_y_hint(y: np.ndarray, hint: np.ndarray) -> np.ndarray:
+    """Frames (..., 3, 3) whose columns are X, Y, Z (see frame_axes)."""
+    return np.stack(frame_axes(y, hint), axis=-1)
 
 
 def _sub(a, b):
@@ -99,9 +113,9 @@ def up_vector(get: GetJoint, fallback: np.ndarray) -> np.ndarray:
 def rotate_minimal(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Rotate v by the smallest rotation taking unit a to unit b (Rodrigues without normalising the axis;
     a and b are never opposite for neighbouring limb segments)."""
-    k = np.cross(a, b)
+    k = _cross(a, b)
     c = np.sum(a * b, axis=-1, keepdims=True)
-    return v * c + np.cross(k, v) + k * np.sum(k * v, axis=-1, keepdims=True) / np.maximum(1.0 + c, 1e-9)
+    return v * c + _cross(k, v) + k * np.sum(k * v, axis=-1, keepdims=True) / np.maximum(1.0 + c, 1e-9)
 
 
 def hinge_axis(get: GetJoint, side: str, kind: str, y_upper: np.ndarray, world_lateral: np.ndarray,
@@ -112,13 +126,13 @@ def hinge_axis(get: GetJoint, side: str, kind: str, y_upper: np.ndarray, world_l
     upper = _sub(get(b + side), get(a + side))
     lower = _sub(get(c + side), get(b + side))
     y_upper = normalize(y_upper)
-    bend = np.zeros_like(y_upper) if upper is None or lower is None else np.cross(
+    bend = np.zeros_like(y_upper) if upper is None or lower is None else _cross(
         normalize(upper), normalize(lower))
     lat = normalize(lateral(get, upper=(kind == "arm"), fallback=world_lateral))
     if kind == "arm":
-        forward = np.cross(lat, normalize(up_vector(get, world_up)))
+        forward = _cross(lat, normalize(up_vector(get, world_up)))
         # the small -lateral term settles the arm-straight-forward case, where y × forward vanishes
-        default = np.cross(y_upper, forward) - 0.05 * lat
+        default = _cross(y_upper, forward) - 0.05 * lat
     else:
         default = lat
     default = default - np.sum(default * y_upper, axis=-1, keepdims=True) * y_upper
@@ -156,10 +170,10 @@ def segment_hint(get: GetJoint, tail: str, y: np.ndarray, world_lateral: np.ndar
     """The X-direction hint for the segment ending at joint `tail` whose direction is `y`."""
     role, side = role_and_side(tail)
     if role in ("pelvis", "spine"):
-        return np.cross(y, lateral(get, upper=False, fallback=world_lateral))
+        return _cross(y, lateral(get, upper=False, fallback=world_lateral))
     if role in ("chest", "neck", "head"):
-        return np.cross(y, lateral(get, upper=True, fallback=world_lateral))
+        return _cross(y, lateral(get, upper=True, fallback=world_lateral))
     if role in ("clavicle", "hip"):
-        return np.cross(y, up_vector(get, world_up))
+        return _cross(y, up_vector(get, world_up))
     kind, level = LIMB_LEVELS[role]
     return limb_hint(get, side, kind, level, y, world_lateral, world_up, cache)

@@ -8,20 +8,22 @@ import numpy as np
 
 
 def normalize(v: np.ndarray, eps: float = 1e-12) -> np.ndarray:
-    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    n = np.sqrt(np.einsum("...i,...i->...", v, v))[..., None]  # einsum: one pass, no temporary
     return v / np.maximum(n, eps)
 
 
 def mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Hamilton product a * b (apply b first, then a)."""
-    aw, ax, ay, az = np.moveaxis(np.asarray(a, dtype=np.float64), -1, 0)
-    bw, bx, by, bz = np.moveaxis(np.asarray(b, dtype=np.float64), -1, 0)
-    return np.stack([
-        aw * bw - ax * bx - ay * by - az * bz,
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-    ], axis=-1)
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    aw, ax, ay, az = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
+    bw, bx, by, bz = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = aw * bw - ax * bx - ay * by - az * bz
+    out[..., 1] = aw * bx + ax * bw + ay * bz - az * by
+    out[..., 2] = aw * by - ax * bz + ay * bw + az * bx
+    out[..., 3] = aw * bz + ax * by - ay * bx + az * bw
+    return out
 
 
 def conjugate(q: np.ndarray) -> np.ndarray:
@@ -44,25 +46,29 @@ def to_matrix(q: np.ndarray) -> np.ndarray:
     return m
 
 
-def from_matrix(m: np.ndarray) -> np.ndarray:
-    """(..., 3, 3) rotation matrices -> (..., 4) unit quaternions with w >= 0.
+def from_axes(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Quaternions (..., 4), w >= 0, of the rotations whose matrix columns are the unit axes x, y, z (..., 3).
 
     Where w is large the trace formula is exact and cheap; elsewhere (rotations beyond ~140°) the largest of
     the four components is the pivot, so the result stays exact near 180° too."""
-    m = np.asarray(m, dtype=np.float64)
-    q = np.empty(m.shape[:-2] + (4,))
-    t = 1 + m[..., 0, 0] + m[..., 1, 1] + m[..., 2, 2]  # 4w²
+    t = 1 + x[..., 0] + y[..., 1] + z[..., 2]  # 4w²
     big = t > 0.5
-    if np.all(big):
-        s = 2 * np.sqrt(t)  # 4w
-        q[..., 0] = s / 4
-        q[..., 1] = (m[..., 2, 1] - m[..., 1, 2]) / s
-        q[..., 2] = (m[..., 0, 2] - m[..., 2, 0]) / s
-        q[..., 3] = (m[..., 1, 0] - m[..., 0, 1]) / s
-        return q
-    q[big] = from_matrix(m[big]) if np.any(big) else q[big]
-    q[~big] = _from_matrix_pivot(m[~big])
+    s = 2 * np.sqrt(np.where(big, t, 1.0))  # 4w
+    q = np.empty(t.shape + (4,))
+    q[..., 0] = s / 4
+    q[..., 1] = (y[..., 2] - z[..., 1]) / s
+    q[..., 2] = (z[..., 0] - x[..., 2]) / s
+    q[..., 3] = (x[..., 1] - y[..., 0]) / s
+    if not np.all(big):
+        small = ~big
+        q[small] = _from_matrix_pivot(np.stack([x[small], y[small], z[small]], axis=-1))
     return q
+
+
+def from_matrix(m: np.ndarray) -> np.ndarray:
+    """(..., 3, 3) rotation matrices -> (..., 4) unit quaternions with w >= 0 (see from_axes)."""
+    m = np.asarray(m, dtype=np.float64)
+    return from_axes(m[..., :, 0], m[..., :, 1], m[..., :, 2])
 
 
 def _from_matrix_pivot(m: np.ndarray) -> np.ndarray:

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .conventions import KINECT_TO_BLENDER
-from .joint_frames import ALIASES, frame_from_y_hint, resolver, role_and_side, segment_hint
-from .quat import conjugate, from_matrix, mul, rotate
+from .joint_frames import ALIASES, frame_axes, frame_from_y_hint, resolver, role_and_side, segment_hint
+from .quat import conjugate, from_axes, from_matrix, mul, rotate
 from .skeletons import Skeleton
 from .target_rig import TargetRig
 
@@ -132,8 +132,8 @@ class Retargeter:
         tpos = target_joint_positions(skeleton, rig, self.mapped, self.world_up)
         get_t = _drop_unknown(resolver(skeleton.joints, tpos))
         self.target_leg = leg_length(get_t)
-        # constant per bone: C_b = O_tᵀ · R_rest(b)
-        self.constants = np.empty((len(self.mapped), 3, 3))
+        # the target's rest frame O_t per bone (eq. 11 uses O_tᵀ · R_rest(b))
+        self.rest_frames = np.empty((len(self.mapped), 3, 3))
         for k, m in enumerate(self.mapped):
             y = rig.rest[m.index, :3, 1]
             if is_axial_control(m, rig, self.world_up):
@@ -142,9 +142,9 @@ class Retargeter:
                 y = self.world_up
             hint = segment_hint(get_t, m.tail_name, y, self.world_lateral, self.world_up)
             o_t = frame_from_y_hint(y, np.nan_to_num(hint))
-            self.constants[k] = o_t.T @ rig.rest[m.index, :3, :3]
+            self.rest_frames[k] = o_t
         self._chain_plan()
-        self.constants_q = from_matrix(self.constants)
+        self.rest_q = from_matrix(rig.rest[self.bone_indices, :3, :3])
         self.root_scale = root_scale
 
     def _chain_plan(self) -> None:
@@ -198,8 +198,13 @@ class Retargeter:
         y = np.stack([p[m.tail] - p[m.head] for m in self.mapped])                    # (M, F, 3)
         hints = np.stack([segment_hint(get, m.tail_name, y[k], self.world_lateral, self.world_up, cache)
                           for k, m in enumerate(self.mapped)])
-        # quaternion products are cheaper than stacks of 3x3 matrix products
-        desired = mul(from_matrix(frame_from_y_hint(y, hints)), self.constants_q[:, None])  # (M, F, 4), eq. 11
+        # eq. 11 as (O_s · O_tᵀ) · R_rest: the first factor is the segment's turn away from the rest pose, a
+        # moderate rotation whose quaternion comes from the cheap trace formula; its columns are sums of O_s's
+        # axes with constant weights. Quaternion products then beat stacks of 3x3 matrix products.
+        x, y_axis, z = frame_axes(y, hints)
+        o_t = self.rest_frames[:, None, :, None, :]  # (M, 1, row, 1, col) broadcasts against (M, F, 3)
+        turn = [x * o_t[:, :, j, :, 0] + y_axis * o_t[:, :, j, :, 1] + z * o_t[:, :, j, :, 2] for j in range(3)]
+        desired = mul(from_axes(*turn), self.rest_q[:, None])                       # (M, F, 4), eq. 11
         frame_rot = np.broadcast_to(self.static_q[:, None], desired.shape).copy()
         if self.has_anchor.any():
             frame_rot[self.has_anchor] = mul(desired[self.anchor[self.has_anchor]],
