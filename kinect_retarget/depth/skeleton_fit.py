@@ -18,6 +18,8 @@ from . import body_model_fit as bm
 from .geodesic import SurfaceGraph, geodesic_extrema, geodesic_maxima, level_set_centroid
 
 J = {n: i for i, n in enumerate(KINECT_V1.joints)}
+# weights of the elbow/knee choice on the IK circle (per metre): level-set centroid, previous frame
+W_LEVEL_SET, W_PREVIOUS = 1.0, 0.3
 GEODESIC_ROWS = 1000   # no subsampling below the tracker's grid: coarser cells merge arms with the body
 EXTREMA = "plagemann"     # "maxima" (one geodesic run) or "plagemann" (one run per extremum, slower)
 SIDES = ("Left", "Right")
@@ -249,9 +251,9 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
             cands, end_p2 = two_bone_candidates(a, end_p, l1, l2)
             cost = proj.cost(cands, bm.DEPTH_INSIDE[mid])
             if mid_ls is not None:
-                cost = cost + 0.5 * np.linalg.norm(cands - (mid_ls + inside(mid)), axis=1)
+                cost = cost + W_LEVEL_SET * np.linalg.norm(cands - (mid_ls + inside(mid)), axis=1)
             if prev is not None and prev_states is not None and prev_states[J[f"{mid}{s}"]] != NOT_TRACKED:
-                cost = cost + 0.3 * np.linalg.norm(cands - prev[J[f"{mid}{s}"]], axis=1)
+                cost = cost + W_PREVIOUS * np.linalg.norm(cands - prev[J[f"{mid}{s}"]], axis=1)
             else:  # no history: elbows bend backwards/outwards, knees forwards
                 pref = -view if root == "Hip" else (view + lat * (1 if s == "Left" else -1))
                 cost = cost - 0.02 * ((cands - a) @ _unit(pref))
