@@ -29,6 +29,8 @@ def add_parser(sub) -> None:
     p.add_argument("--speed", type=float, default=1.0, help="take playback speed (take: sources)")
     p.add_argument("--loop", action="store_true", help="loop take playback")
     p.add_argument("--host", default="127.0.0.1", help="OSC listen address (default: this computer only)")
+    p.add_argument("--simulate", action="store_true",
+                   help="usb: the emulated Kinect streaming rendered depth of real mocap, through the depth tracker")
     p.add_argument("--record", metavar="TAKE_OUT", help="record every received frame to this .krtake")
     p.add_argument("--out", metavar="OUT.blend", help="save the rig (with the baked recording) here")
     p.set_defaults(handler=run_live)
@@ -62,7 +64,8 @@ def run_live(args) -> int:
     if not args.seconds > 0:
         raise ValueError("--seconds must be positive")
     try:
-        source = open_source(args.source, speed=args.speed, loop=args.loop, host=args.host)
+        source = open_source(args.source, speed=args.speed, loop=args.loop, host=args.host,
+                             simulate=args.simulate)
     except SourceError as exc:  # bad input fails before Blender starts
         raise ValueError(str(exc)) from None
     overrides = None
