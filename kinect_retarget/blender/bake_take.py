@@ -81,8 +81,11 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
         scene.render.fps = max(1, int(round(motion.fps)))
         scene.render.fps_base = scene.render.fps / motion.fps
         scene.frame_start, scene.frame_end = first, last
+    skipped = motion.extras.get("skipped_bones", ())
     report({"INFO"}, f"Baked {len(motion.frames)} frames ({len(motion.bone_names)} bones, preset {used}) "
-                     f"onto {obj.name!r} as action {action.name!r}")
+                     f"onto {obj.name!r} as action {action.name!r}"
+                     + (f"; left alone (the take has no position for their joints): {', '.join(skipped)}"
+                        if skipped else ""))
     if progress:
         progress(1.0)
     return BakeResult(action, motion, used, (first, last))

@@ -213,3 +213,20 @@ def test_unmapped_bones_and_inherit_rotation_flags(hop):
     elbow = KINECT_V1.index("ElbowLeft")
     np.testing.assert_allclose(posed[:, elbow, :3, :3], np.broadcast_to(rig.rest[elbow, :3, :3], (len(posed), 3, 3)),
                                atol=1e-12)
+
+
+def test_joints_without_positions_never_reach_the_keys(shared_data):
+    """UI-PRMD has no hand joints (NaN, untracked): their bones are left alone, nothing NaN is keyed, live too."""
+    take = load_take(shared_data / "kinect_v2_vicon_uiprmd" / "Kinect" / "m07_s01_e01_positions.txt")
+    assert np.isnan(take.positions).any()
+    rig = generated_rig(take.skeleton, median_segment_lengths(take))
+    for flt in ("none", "default"):
+        pipe = RetargetPipeline(take.skeleton, rig, generated_mapping(take.skeleton), RetargetSettings(filter=flt))
+        m = pipe.process_take(take)
+        assert np.isfinite(m.quats).all() and np.isfinite(m.root_location).all()
+        assert set(m.extras["skipped_bones"]) == {"HandLeft", "HandRight", "HandTipLeft", "HandTipRight",
+                                                  "ThumbLeft", "ThumbRight"}
+        assert "ElbowLeft" in m.bone_names
+        pipe.reset(take.rate)
+        poses = [pipe.process_frame(take.positions[i], take.states[i], take.times[i]) for i in range(10)]
+        assert all(np.isfinite(p.quats).all() for p in poses)
