@@ -33,6 +33,8 @@ class FitResult:
     extrema: list = field(default_factory=list)   # [(label, xyz)] for previews and tests
     torso_centre: np.ndarray | None = None
     head_top: np.ndarray | None = None
+    projector: "Projector | None" = None          # for the confidence checks after the fit
+    edge_on: bool = False                          # the chest's normal was unusable (seen side-on)
 
 
 def _unit(v):
@@ -129,7 +131,8 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     view = _unit(centre)
     facing = vt[2] if vt[2] @ view < 0 else -vt[2]  # the chest's normal, toward the sensor
     facing = _unit(facing - (facing @ axis) * axis)
-    if facing @ -view < 0.3:  # seen nearly edge-on: the normal is unreliable, assume facing the sensor
+    edge_on = bool(facing @ -view < 0.3)
+    if edge_on:  # seen nearly edge-on: the normal is unreliable, assume facing the sensor
         facing = _unit(-view - (-view @ axis) * axis)
     lat = _unit(np.cross(axis, facing))  # points to the performer's left
     if prev_lateral is not None:
@@ -274,7 +277,7 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     if facing @ -view < 0.7:
         for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
             st[J[name]] = INFERRED
-    return FitResult(pos, st, lat, labels, centre, None if head is None else head[1])
+    return FitResult(pos, st, lat, labels, centre, None if head is None else head[1], proj, edge_on)
 
 
 def _shoulder_top(xyz, mask, centre, axis, lat, H, expect):

@@ -17,6 +17,7 @@ from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED
 from ..core.take import Take
 from .body_model_fit import BodyCalibration
 from .camera import DepthCamera
+from .confidence import ConfidenceCheck
 from .segmentation import DepthGrid, FloorPlane, PersonMask, find_people, fit_floor
 from .skeleton_fit import J, FitResult, fit_person
 
@@ -42,6 +43,7 @@ class SkeletonTracker:
     def reset(self) -> None:
         self.floor: FloorPlane | None = None
         self.calibration = BodyCalibration()
+        self.confidence = ConfidenceCheck()
         self.status = "waiting for a person"
         self.frames = 0
         self._prev: np.ndarray | None = None
@@ -100,14 +102,15 @@ class SkeletonTracker:
         if fit is None or not np.all(np.isfinite(fit.positions)):
             self._lose(ts)
             return self._none("person found but no skeleton fitted")
-        pos, st = fit.positions, fit.states
+        pos, st = fit.positions, self.confidence.assess(fit.positions, fit.states, fit)
         self.last_grid = grid
         self._calibrate(person, fit, up)
         if self._prev is not None and self.settings.smoothing > 0:
             step = np.linalg.norm(pos - self._prev, axis=1, keepdims=True)
             w = self.settings.smoothing * np.clip(1.0 - step / 0.08, 0.0, 1.0)  # fast moves are not lagged
             pos = pos + w * (self._prev - pos)
-        self._prev, self._prev_states, self._lateral = pos.copy(), st.copy(), fit.lateral
+        self.confidence.remember(pos)
+        self._prev, self._prev_states, self._lateral = pos.copy(), fit.states.copy(), fit.lateral
         self._person_centroid, self._last_seen = person.centroid, ts
         self.last_mask, self.last_fit, self.last_good = person.mask, fit, fit
         self.status = "tracking" if self.calibration.frames else "tracking (calibrating)"
@@ -116,6 +119,7 @@ class SkeletonTracker:
     def _lose(self, ts: float) -> None:
         if self._last_seen is None or not np.isfinite(ts) or ts - self._last_seen > LOST_RESET_S:
             self._prev = self._prev_states = self._lateral = self._person_centroid = self.last_good = None
+            self.confidence.reset()
 
     def _choose(self, people: list[PersonMask], ts: float) -> PersonMask | None:
         """The tracked person by continuity; a new one is the largest person-like, most central region."""

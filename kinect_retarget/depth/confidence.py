@@ -1,0 +1,75 @@
+"""Honest tracking states: demote a fitted joint to INFERRED when the depth data does not back it up.
+
+The fit marks a joint TRACKED when it rests on evidence (torso patch, extremity, level set). These checks,
+run after the fit, catch the cases where that evidence was misleading, as the SDK does: a joint that
+disagrees with the motion of the previous frames (a torso patch that slid, an extremity handed to the wrong
+limb), a limb joint that projects off the person or in front of the surface (occluded, or placed where the
+body is not), every limb when the torso is seen edge-on (the sides overlap in depth), and a joint that only
+just recovered from being flagged (one good frame is not yet evidence).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.skeletons import INFERRED, KINECT_V1, TRACKED
+from . import body_model_fit as bm
+
+J = {n: i for i, n in enumerate(KINECT_V1.joints)}
+TORSO = [J[n] for n in ("HipCenter", "Spine", "ShoulderCenter", "Head")]
+SIDE_TORSO = [J[f"{p}{s}"] for p in ("Shoulder", "Hip") for s in ("Left", "Right")]
+# limb chains, root first: a demoted joint demotes everything beyond it
+CHAINS = [[J[f"{n}{s}"] for n in names] for s in ("Left", "Right")
+          for names in (("Elbow", "Wrist", "Hand"), ("Knee", "Ankle", "Foot"))]
+LIMB = [j for chain in CHAINS for j in chain]
+# how far (m) a joint may land from its constant-velocity prediction before the fit is doubted: the torso
+# moves smoothly; hands and feet swing fast
+PREDICTION_SLACK = np.full(20, 0.25)
+PREDICTION_SLACK[TORSO + SIDE_TORSO] = 0.10
+VELOCITY_DAMPING = 0.5   # a fraction of the last frame's velocity is carried on (prediction, not extrapolation)
+EDGE_ON_DEMOTES = True   # side-on, the sides overlap in depth: limbs and shoulder/hip lines are guesses
+RECOVERY_FRAMES = 1      # frames a joint stays flagged after its checks pass again
+LIMB_DEPTH_INSIDE = np.array([bm.DEPTH_INSIDE[KINECT_V1.joints[j].replace("Left", "").replace("Right", "")]
+                              for j in LIMB])
+OFF_SURFACE = 0.2        # Projector.cost at or above this: off the person's silhouette or well in front of it
+
+
+class ConfidenceCheck:
+    """Per-tracker state (the last two fitted poses, recent flags) and the per-frame demotion."""
+
+    def __init__(self):
+        self.reset()
+
+    def reset(self) -> None:
+        self._history: list[np.ndarray] = []
+        self._flag_age = np.full(20, RECOVERY_FRAMES + 1)
+
+    def predict(self) -> np.ndarray | None:
+        if not self._history:
+            return None
+        if len(self._history) == 1:
+            return self._history[-1]
+        a, b = self._history[-2], self._history[-1]
+        return b + VELOCITY_DAMPING * (b - a)
+
+    def assess(self, positions: np.ndarray, states: np.ndarray, fit) -> np.ndarray:
+        """States after the checks (never promotes a joint). `fit` is the frame's FitResult."""
+        st = states.copy()
+        doubt = np.zeros(20, bool)
+        pred = self.predict()
+        if pred is not None:
+            doubt |= np.linalg.norm(positions - pred, axis=1) > PREDICTION_SLACK
+        proj = getattr(fit, "projector", None)
+        if proj is not None:
+            doubt[LIMB] |= proj.cost(positions[LIMB], LIMB_DEPTH_INSIDE) >= OFF_SURFACE
+        if EDGE_ON_DEMOTES and getattr(fit, "edge_on", False):
+            doubt[LIMB + SIDE_TORSO] = True
+        for chain in CHAINS:   # beyond a doubtful joint the chain hangs on a guess
+            bad = np.cumsum(doubt[chain] | (st[chain] != TRACKED)) > 0
+            doubt[chain] |= bad & (st[chain] == TRACKED)
+        self._flag_age = np.where(doubt, 0, self._flag_age + 1)
+        st[(self._flag_age <= RECOVERY_FRAMES) & (st == TRACKED)] = INFERRED
+        return st
+
+    def remember(self, positions: np.ndarray) -> None:
+        """The pose the tracker output (after its filter): the motion model predicts from these."""
+        self._history = (self._history + [positions.copy()])[-2:]
