@@ -4,7 +4,9 @@ The fit marks a joint TRACKED when it rests on evidence (torso patch, extremity,
 run after the fit, catch the cases where that evidence was misleading, as the SDK does: a joint that
 disagrees with the motion of the previous frames (a torso patch that slid, an extremity handed to the wrong
 limb), a limb joint that projects off the person or in front of the surface (occluded, or placed where the
-body is not), every limb when the torso is seen edge-on (the sides overlap in depth), and a joint that only
+body is not), every limb when the torso is seen edge-on (the sides overlap in depth) or fewer than three of the five
+extremities show (side-on, curled up: what was found may be labelled wrongly), the hips when the head is not
+seen (the torso was then placed from the shoulders alone), and a joint that only
 just recovered from being flagged (one good frame is not yet evidence).
 """
 from __future__ import annotations
@@ -16,6 +18,7 @@ from . import body_model_fit as bm
 
 J = {n: i for i, n in enumerate(KINECT_V1.joints)}
 TORSO = [J[n] for n in ("HipCenter", "Spine", "ShoulderCenter", "Head")]
+LOWER_TORSO = [J[n] for n in ("HipCenter", "Spine", "HipLeft", "HipRight")]
 SIDE_TORSO = [J[f"{p}{s}"] for p in ("Shoulder", "Hip") for s in ("Left", "Right")]
 # limb chains, root first: a demoted joint demotes everything beyond it
 CHAINS = [[J[f"{n}{s}"] for n in names] for s in ("Left", "Right")
@@ -26,6 +29,7 @@ LIMB = [j for chain in CHAINS for j in chain]
 PREDICTION_SLACK = np.full(20, 0.25)
 PREDICTION_SLACK[TORSO + SIDE_TORSO] = 0.10
 VELOCITY_DAMPING = 0.5   # a fraction of the last frame's velocity is carried on (prediction, not extrapolation)
+MIN_EXTREMITIES = 3      # of head, hands and feet; fewer and the labelling of what was found is a guess
 EDGE_ON_DEMOTES = True   # side-on, the sides overlap in depth: limbs and shoulder/hip lines are guesses
 RECOVERY_FRAMES = 1      # frames a joint stays flagged after its checks pass again
 LIMB_DEPTH_INSIDE = np.array([bm.DEPTH_INSIDE[KINECT_V1.joints[j].replace("Left", "").replace("Right", "")]
@@ -62,6 +66,11 @@ class ConfidenceCheck:
         if proj is not None:
             doubt[LIMB] |= proj.cost(positions[LIMB], LIMB_DEPTH_INSIDE) >= OFF_SURFACE
         if EDGE_ON_DEMOTES and getattr(fit, "edge_on", False):
+            doubt[LIMB + SIDE_TORSO] = True
+        found = {label for label, _ in getattr(fit, "extrema", [])}
+        if "head" not in found:   # the torso was placed from the shoulder tops alone: the hips are far from it
+            doubt[LOWER_TORSO] = True
+        if len(found) < MIN_EXTREMITIES:   # not the shape of a person facing the sensor (side-on, curled up)
             doubt[LIMB + SIDE_TORSO] = True
         for chain in CHAINS:   # beyond a doubtful joint the chain hangs on a guess
             bad = np.cumsum(doubt[chain] | (st[chain] != TRACKED)) > 0

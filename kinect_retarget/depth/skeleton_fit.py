@@ -23,6 +23,8 @@ W_LEVEL_SET, W_PREVIOUS = 1.0, 0.3
 GEODESIC_ROWS = 1000   # no subsampling below the tracker's grid: coarser cells merge arms with the body
 EXTREMA = "plagemann"     # "maxima" (one geodesic run) or "plagemann" (one run per extremum, slower)
 SIDES = ("Left", "Right")
+AXIS_GRAVITY_WEIGHT = 0.75  # torso axis = this blend of gravity's up and the torso patch's long axis
+REACH_SLACK = 0.10          # m an extremity may lie beyond the limb's calibrated reach and still be its end
 
 
 @dataclass
@@ -127,7 +129,8 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     centre = np.median(patch, axis=0)  # the median ignores a hanging arm caught at the patch's edge
     _, _, vt = np.linalg.svd(patch - centre, full_matrices=False)
     axis = vt[0] if vt[0] @ up > 0 else -vt[0]
-    axis = _unit(0.5 * axis + 0.5 * up) if axis @ up > 0.5 else up  # crouched/odd patch: trust gravity
+    # a torso patch's long axis tilts with a swinging arm or a turn; people stand close to upright
+    axis = _unit((1 - AXIS_GRAVITY_WEIGHT) * axis + AXIS_GRAVITY_WEIGHT * up) if axis @ up > 0.5 else up
     view = _unit(centre)
     facing = vt[2] if vt[2] @ view < 0 else -vt[2]  # the chest's normal, toward the sensor
     facing = _unit(facing - (facing @ axis) * axis)
@@ -264,9 +267,11 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
                 cost = cost + 0.3 * np.maximum(0.0, -((cands - (a + end_p2) / 2) @ facing))
             m = cands[int(np.argmin(cost))]
             pos[J[f"{mid}{s}"]] = m
-            shift = end_p2 - end_p  # keep the hand/foot attached when the end was pulled into reach
+            reach_shift = end_p2 - end_p  # keep the hand/foot attached when the end was pulled into reach
             pos[J[f"{end}{s}"]] = end_p2
-            pos[J[f"{tip}{s}"]] = tip_p + shift
+            pos[J[f"{tip}{s}"]] = tip_p + reach_shift
+            if np.linalg.norm(reach_shift) > REACH_SLACK:
+                st_limb = INFERRED  # the extremity is out of this limb's reach: not its hand/foot, or a bad root
             mid_ok = st_limb == TRACKED and proj.supported(m, bm.DEPTH_INSIDE[mid] - 0.02)
             st[J[f"{mid}{s}"]] = TRACKED if mid_ok or st_limb == TRACKED else INFERRED
             st[J[f"{end}{s}"]] = st[J[f"{tip}{s}"]] = st_limb
