@@ -16,14 +16,17 @@ TYPICAL_LENGTHS = {"SpineBase": 0.2, "HipCenter": 0.2, "SpineMid": 0.25, "Spine"
 
 
 def add_parser(sub) -> None:
+    from .core.filters import FILTERS
+    from .core.presets import PRESET_NAMES
+
     p = sub.add_parser("live", help="drive a rig live from a source without a window; prints JSON statistics")
     p.add_argument("--source", required=True, help="take:FILE, osc:PORT or usb")
     p.add_argument("--seconds", type=float, required=True, help="how long to run")
     p.add_argument("--rig", help=".blend holding the target armature (default: a generated Kinect rig)")
     p.add_argument("--armature", help="armature object name in --rig (default: the only armature)")
-    p.add_argument("--preset", default="auto", help="bone-mapping preset (default: auto)")
+    p.add_argument("--preset", default="auto", choices=PRESET_NAMES, help="bone-mapping preset (default: auto)")
     p.add_argument("--mapping", help="JSON bone-mapping overrides")
-    p.add_argument("--filter", default="default", help="jitter filter (default: default)")
+    p.add_argument("--filter", default="default", choices=FILTERS, help="jitter filter (default: default)")
     p.add_argument("--root", default="xyz", choices=("xyz", "xy", "none"), help="root motion")
     p.add_argument("--mirror", action="store_true", help="swap the performer's left and right")
     p.add_argument("--speed", type=float, default=1.0, help="take playback speed (take: sources)")

@@ -101,3 +101,10 @@ def test_live_osc_receives_ni_mate_frames_and_stops_on_garbage(tmp_path):
     kept = krtake.read(rec)
     assert kept.frame_count == 40  # everything received before the garbage is kept
     np.testing.assert_allclose(kept.positions[0, idx["Left_Hand"]], take.positions[0, idx["Left_Hand"]], atol=1e-5)
+
+
+def test_live_unknown_preset_or_filter_is_a_usage_error_not_a_traceback():
+    for flag in ("--preset", "--filter"):
+        proc = run_cli("--source", f"take:{SAMPLE}", "--seconds", "1", flag, "bogus")
+        assert proc.returncode == 2, proc.stderr[-2000:]
+        assert "invalid choice: 'bogus'" in proc.stderr and "Traceback" not in proc.stderr
