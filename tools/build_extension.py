@@ -58,6 +58,9 @@ def blender_ext_script() -> Path:
     return hits[-1]
 
 
+DOWNLOAD_TIMEOUT = 300  # seconds for one wheel
+
+
 def wheel_cache() -> Path:
     return Path(os.environ.get("KINECT_RETARGET_WHEEL_CACHE", Path.home() / ".cache" / "kinect_retarget" / "wheels"))
 
@@ -75,7 +78,11 @@ def fetch_wheel(filename: str, cache: Path) -> Path:
            "--python-version", "3.11", "--dest", str(cache), f"{m['dist']}=={m['ver']}"]
     if m["plat"] != "any":
         cmd += [arg for plat in m["plat"].split(".") for arg in ("--platform", plat)]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
+    cmd[4:4] = ["--timeout", "30", "--retries", "2"]  # an unreachable index fails in minutes, never hangs
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=DOWNLOAD_TIMEOUT)
+    except subprocess.TimeoutExpired:
+        raise BuildError(f"could not download {filename} from PyPI: no answer in {DOWNLOAD_TIMEOUT} s") from None
     if proc.returncode != 0 or not target.is_file():
         raise BuildError(f"could not download {filename} from PyPI:\n{proc.stderr.strip()[-800:]}")
     return target

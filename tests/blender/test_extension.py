@@ -28,10 +28,18 @@ def extension_zip(tmp_path_factory):
         import build_extension
     finally:
         sys.path.pop(0)
+    # a fresh wheel cache: the test proves the download works and never writes to ~/.cache
+    saved = os.environ.get("KINECT_RETARGET_WHEEL_CACHE")
+    os.environ["KINECT_RETARGET_WHEEL_CACHE"] = str(tmp_path_factory.mktemp("wheel_cache"))
     try:
         return build_extension.build(tmp_path_factory.mktemp("dist"))
     except build_extension.BuildError as exc:
         pytest.fail(f"extension build failed: {exc}")
+    finally:
+        if saved is None:
+            del os.environ["KINECT_RETARGET_WHEEL_CACHE"]
+        else:
+            os.environ["KINECT_RETARGET_WHEEL_CACHE"] = saved
 
 
 def test_zip_has_manifest_package_and_every_platforms_wheels(extension_zip):
