@@ -62,6 +62,8 @@ def test_zip_has_manifest_package_and_every_platforms_wheels(extension_zip):
 
 def test_install_enable_bake_disable_in_the_bpy_extension_repository(extension_zip, tmp_path):
     assert SAMPLE.is_file(), f"sample take missing: {SAMPLE}"
+    real_install = Path.home() / ".config" / "blender" / "5.0" / "extensions" / "user_default" / "kinect_retarget"
+    before = real_install.exists()
     env = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_path / "blender_user"))
     proc = subprocess.run([sys.executable, __file__, "--child", str(extension_zip), str(SAMPLE)],
                           capture_output=True, text=True, env=env, timeout=300)
@@ -73,8 +75,8 @@ def test_install_enable_bake_disable_in_the_bpy_extension_repository(extension_z
     assert result["bake"] == ["FINISHED"] and result["keys"] > 100
     assert result["after_disable"] == {"classes": [], "timers": False, "handlers": [], "threads": []}
     assert result["after_cycles"] == {"classes": [], "timers": False, "handlers": [], "threads": []}
-    assert not (Path.home() / ".config" / "blender" / "5.0" / "extensions" / "user_default" /
-                "kinect_retarget" / "__init__.py").exists() or True  # never written there by this test
+    assert real_install.exists() == before, "the test installed into the user's real Blender configuration"
+    assert (tmp_path / "blender_user").is_dir()  # it went to the child's own BLENDER_USER_RESOURCES
 
 
 def test_register_unregister_three_times_leaves_nothing(shared_data, tmp_path):
