@@ -37,8 +37,9 @@ class FrameSource:
 
     # -- lifecycle, called from the main thread --------------------------------------------------------
     def start(self, queue: FrameQueue) -> None:
-        if self._thread is not None:
-            raise SourceError(f"{self.describe()} is already started")
+        if self._thread is not None and self._thread.is_alive():
+            raise SourceError(f"{self.describe()} is still running; stop it (and let it end) first")
+        self._thread = None
         self._queue = queue
         self._stop.clear()
         self._open()  # may raise SourceError synchronously (missing file, port in use)
@@ -49,8 +50,11 @@ class FrameSource:
 
     def stop(self, timeout: float = 2.0) -> None:
         self._stop.set()
-        if self._thread is not None and self._thread is not threading.current_thread():
-            self._thread.join(timeout)
+        thread = self._thread
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(timeout)
+        if thread is not None and thread.is_alive():
+            return  # still blocked in a read: keep it (start() refuses) and close nothing under its feet
         self._thread = None
         self._close()
         if self.status == "running":

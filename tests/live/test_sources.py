@@ -243,3 +243,29 @@ def test_usb_finds_the_depth_tracker_and_times_out_without_frames(monkeypatch):
     assert wait_until(lambda: src.status == "error")
     src.stop()
     assert "no depth frame" in src.error and "unplugged" in src.error
+
+
+def test_stop_keeps_a_thread_that_has_not_ended_and_start_refuses_a_second_one(rng):
+    import threading
+
+    release = threading.Event()
+
+    class Stuck(FakeProducer):  # a read that ignores stop() for a while (a USB transfer in flight)
+        def read(self, timeout):
+            release.wait(10)
+            return None
+
+    prod = Stuck([])
+    src = UsbKinectSource(factory=lambda: prod)
+    src.start(FrameQueue())
+    src.stop(timeout=0.05)
+    assert src.alive and not prod.closed  # nothing closed under the running reader
+    with pytest.raises(SourceError, match="still running"):
+        src.start(FrameQueue())
+    release.set()
+    assert wait_until(lambda: not src.alive)
+    src.stop()
+    assert prod.closed
+    src.start(FrameQueue())  # the old reader has ended: a restart is fine
+    src.stop()
+    assert not src.alive
