@@ -37,11 +37,19 @@ def _write_curves(channelbag, data_path: str, group: str, frames: np.ndarray, va
         # bpy_extras.anim_utils.KeyframesCo.insert_keyframes_into_new_action)
 
 
+def keep_alive(action: bpy.types.Action | None) -> None:
+    """An Action about to be unassigned keeps a user, so saving the file does not drop it."""
+    if action is not None and action.users <= 1 and not action.use_fake_user:
+        action.use_fake_user = True
+
+
 def bake_motion(obj: bpy.types.Object, motion: BakedMotion, action_name: str,
                 extra_curves: list[tuple[str, str, np.ndarray]] = ()) -> bpy.types.Action:
     """Create an Action with one slot for `obj`, key every mapped bone, assign it. Returns the Action.
 
-    extra_curves: (data_path, group, values (N, C)) keyed at the same frames (e.g. Rigify's FK switches).
+    extra_curves: (data_path, group, values (C,)) constant channels keyed once at the first frame (e.g.
+    Rigify's FK switches). The Action the object had stays in the file (it gets a fake user if this bake
+    would leave it with none), so baking never loses the user's animation.
     """
     action, slot, channelbag = _new_action(obj, action_name)
     frames = motion.frames.astype(np.float32)
@@ -54,9 +62,9 @@ def bake_motion(obj: bpy.types.Object, motion: BakedMotion, action_name: str,
         path = f'pose.bones["{escape_identifier(motion.root_bone)}"].location'
         _write_curves(channelbag, path, motion.root_bone, frames, motion.root_location)
     for data_path, group, values in extra_curves:
-        _write_curves(channelbag, data_path, group, frames, np.broadcast_to(values, (len(frames),) +
-                                                                            np.shape(values)[-1:]))
+        _write_curves(channelbag, data_path, group, frames[:1], np.reshape(values, (1, -1)))
     ad = obj.animation_data or obj.animation_data_create()
+    keep_alive(ad.action)
     ad.action = action
     ad.action_slot = slot
     return action

@@ -7,6 +7,7 @@ from typing import Callable
 
 import bpy
 import numpy as np
+from bpy.utils import escape_identifier
 
 from ..core.kinect_rig_layout import median_segment_lengths
 from ..core.pipeline import BakedMotion, RetargetPipeline, RetargetSettings
@@ -15,6 +16,7 @@ from ..core.take import Take
 from .bake import bake_motion
 from .evaluated_solve import correct_for_evaluation
 from .kinect_rig import build_kinect_rig
+from .pose_apply import restore_pose, snapshot_pose
 from .rig_reader import has_constrained_ancestry, target_rig_from_object
 
 Report = Callable[[set, str], None]
@@ -60,19 +62,23 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
         progress(0.3)
     extra = []
     if used == "rigify":
-        extra = [(f'pose.bones["{b}"]["IK_FK"]', b, np.ones((1, 1))) for b in RIGIFY_FK_SWITCHES
+        extra = [(f'pose.bones["{escape_identifier(b)}"]["IK_FK"]', b, np.ones(1)) for b in RIGIFY_FK_SWITCHES
                  if b in obj.pose.bones and "IK_FK" in obj.pose.bones[b]]
     if has_constrained_ancestry(obj, motion.bone_names):
         saved = {name: obj.pose.bones[name].get("IK_FK") for _, name, _ in extra}
-        for _, name, _ in extra:
-            obj.pose.bones[name]["IK_FK"] = 1.0
-        n = len(motion.frames)
-        motion.quats = correct_for_evaluation(
-            obj, motion.bone_names, motion.quats, motion.root_bone, motion.root_location,
-            motion.extras["desired"], (lambda f: progress(0.3 + 0.6 * f / n)) if progress else None)
-        for name, value in saved.items():
-            if value is not None:
-                obj.pose.bones[name]["IK_FK"] = value
+        saved_pose = snapshot_pose(obj)
+        try:
+            for _, name, _ in extra:
+                obj.pose.bones[name]["IK_FK"] = 1.0
+            n = len(motion.frames)
+            motion.quats = correct_for_evaluation(
+                obj, motion.bone_names, motion.quats, motion.root_bone, motion.root_location,
+                motion.extras["desired"], (lambda f: progress(0.3 + 0.6 * f / n)) if progress else None)
+        finally:  # the evaluation posed the rig; put the pose and the switches back whatever happened
+            restore_pose(obj, saved_pose)
+            for name, value in saved.items():
+                if value is not None:
+                    obj.pose.bones[name]["IK_FK"] = value
     name = action_name or f"{obj.name}_{take.metadata.get('name', 'take')}"
     action = bake_motion(obj, motion, name, extra)
     first, last = int(motion.frames[0]), int(motion.frames[-1])

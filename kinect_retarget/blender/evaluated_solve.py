@@ -1,24 +1,17 @@
 """Correct solved rotations on rigs whose bone parents are driven by constraints or drivers (e.g. Rigify's
 MCH parents of its FK controls): numpy cannot evaluate those, so Blender evaluates the pose and each bone's
-rotation is corrected toward its desired armature-space rotation, one hierarchy level per pass."""
+rotation is corrected toward its desired armature-space rotation (a few evaluations per frame)."""
 from __future__ import annotations
 
 import bpy
 import numpy as np
 
 from ..core.quat import from_matrix, make_continuous, to_matrix
-from ..core.rotation_modes import channel_values
+from .pose_apply import set_rotations
 
 MAX_PASSES = 8
 TOLERANCE = np.radians(0.05)  # residual (sin of the angle) accepted per bone
 stats = {"frames": 0, "evaluations": 0}  # of the last call, for benchmarks
-
-
-def _set_rotations(pose_bones, bone_names, quats) -> None:
-    for name, q in zip(bone_names, quats):
-        pb = pose_bones[name]
-        suffix, values = channel_values(q, pb.rotation_mode)
-        setattr(pb, suffix, values.tolist())
 
 
 def _mapped_ancestors(pose_bones, bone_names) -> tuple[list[int], list[int]]:
@@ -60,7 +53,7 @@ def correct_for_evaluation(obj: bpy.types.Object, bone_names, quats: np.ndarray,
         basis = plain[f] @ carry
         wanted = to_matrix(desired[f])
         for _ in range(MAX_PASSES):
-            _set_rotations(pose_bones, bone_names, from_matrix(basis))
+            set_rotations(pose_bones, bone_names, from_matrix(basis))
             obj.update_tag()
             view_layer.update()
             stats["evaluations"] += 1

@@ -7,12 +7,17 @@ from ..core.pipeline import FramePose
 from ..core.rotation_modes import channel_values
 
 
+def set_rotations(pose_bones, bone_names, quats) -> None:
+    """quats (M, 4) into each pose bone's own rotation channel (quaternion, Euler order or axis-angle)."""
+    for name, q in zip(bone_names, quats):
+        pb = pose_bones[name]
+        suffix, values = channel_values(q, pb.rotation_mode)
+        setattr(pb, suffix, values.tolist())
+
+
 def apply_frame_pose(obj: bpy.types.Object, pose: FramePose) -> None:
     pose_bones = obj.pose.bones
-    for k, bone in enumerate(pose.bone_names):
-        pb = pose_bones[bone]
-        suffix, values = channel_values(pose.quats[k], pb.rotation_mode)
-        setattr(pb, suffix, values.tolist())
+    set_rotations(pose_bones, pose.bone_names, pose.quats)
     if pose.root_bone is not None:
         pose_bones[pose.root_bone].location = pose.root_location.tolist()
     obj.update_tag()

@@ -28,8 +28,9 @@ def quat_to_euler(q: np.ndarray, order: str) -> np.ndarray:
 
 
 def quat_to_axis_angle(q: np.ndarray) -> np.ndarray:
-    """(..., 4) wxyz -> (..., 4) Blender axis-angle (angle, x, y, z)."""
-    q = np.asarray(q, dtype=np.float64) * np.where(np.asarray(q)[..., :1] < 0, -1.0, 1.0)
+    """(..., 4) wxyz -> (..., 4) Blender axis-angle (angle, x, y, z). The quaternion's sign is kept (angles
+    run past 180° rather than flipping the axis), so sign-continuous quaternions give continuous keys."""
+    q = np.asarray(q, dtype=np.float64)
     s = np.linalg.norm(q[..., 1:], axis=-1, keepdims=True)
     axis = np.where(s > 1e-12, q[..., 1:] / np.maximum(s, 1e-12), np.array([0.0, 1.0, 0.0]))
     angle = 2 * np.arctan2(s[..., 0], q[..., 0])

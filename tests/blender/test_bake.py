@@ -182,3 +182,37 @@ def test_cli_mapping_override_unmaps_bones(shared_data, tmp_path):
     r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(take), "--out", str(out),
                         "--mapping", str(bad)], capture_output=True, text=True)
     assert r.returncode == 2 and "bad.json" in r.stderr
+
+
+def test_baking_again_keeps_the_previous_action_in_the_file(bpy_empty, shared_data, tmp_path):
+    from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
+    bpy = bpy_empty
+    take = load_take(shared_data / "kinect_v2" / "Ges02_balancinghands.csv")
+    obj = new_generated_rig(bpy.context.scene, take)
+    first = bake_take(obj, take, preset="kinect", action_name="first").action
+    bake_take(obj, take, preset="kinect", action_name="second")
+    path = tmp_path / "two.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    assert {"first", "second"} <= set(bpy.data.actions.keys())
+    assert first is not None
+
+
+def test_euler_and_axis_angle_bones_are_keyed_in_their_own_channels(bpy_empty, shared_data):
+    """The rig's rotation modes are kept; Blender's evaluation of Euler/axis-angle keys matches the take."""
+    from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
+    bpy = bpy_empty
+    take = load_take(shared_data / "kinect_v2" / "Ges06_chickenwing.csv")
+    obj = new_generated_rig(bpy.context.scene, take)
+    modes = {"ElbowLeft": "ZXY", "WristLeft": "XYZ", "ElbowRight": "AXIS_ANGLE", "KneeLeft": "YZX"}
+    for bone, mode in modes.items():
+        obj.pose.bones[bone].rotation_mode = mode
+    res = bake_take(obj, take, preset="kinect", settings=RetargetSettings(filter="none"))
+    assert all(obj.pose.bones[b].rotation_mode == m for b, m in modes.items())
+    from bpy_extras import anim_utils
+    paths = {fc.data_path for fc in anim_utils.animdata_get_channelbag_for_assigned_slot(obj.animation_data).fcurves}
+    assert 'pose.bones["ElbowLeft"].rotation_euler' in paths and 'pose.bones["ElbowRight"].rotation_axis_angle' in paths
+    sk = take.skeleton
+    pairs = {b: (sk.joints[sk.parents[sk.index(b)]], b) for b in list(modes) + ["HandLeft", "AnkleLeft"]}
+    errs = _check_directions(bpy, obj, res.motion, take, pairs, every=4)
+    assert errs.max() < 0.5

@@ -65,3 +65,12 @@ def test_axis_angle(rng):
     aa = quat_to_axis_angle(q)
     back = np.concatenate([np.cos(aa[:, :1] / 2), np.sin(aa[:, :1] / 2) * aa[:, 1:]], axis=1)
     assert_quat_equal(back, q, atol=1e-12)
+
+
+def test_axis_angle_keys_stay_continuous_through_half_turns():
+    angles = np.linspace(0.1, 1.9 * np.pi, 200)  # one steady turn past 180° about a fixed axis
+    axis = np.array([0.0, 0.6, 0.8])
+    q = np.concatenate([np.cos(angles / 2)[:, None], np.sin(angles / 2)[:, None] * axis], axis=1)
+    aa = quat_to_axis_angle(q)
+    assert np.all(np.abs(np.diff(aa, axis=0)) < 0.1)
+    np.testing.assert_allclose(aa[:, 0], angles, atol=1e-12)
