@@ -127,6 +127,7 @@ class LiveSession:
                 self.stats.untracked += 1
                 lost = lost or self._lost_tracking(ts)  # stop after the loop: every drained frame is recorded
                 continue
+            lost = None  # tracking came back within this batch: only a loss at its end counts
             self._last_tracked_time = ts
             self.last_tracked_joints = tracked
             if last_tracked is not None:

@@ -143,3 +143,22 @@ def test_stale_frames_are_not_shown(wave_take, stand_in):
     s.queue.put(SkeletonFrame(wave_take.positions[0], wave_take.states[0], 0.0, 99.5))
     s.pump()
     assert s.stats.stale == 1 and s.stats.applied == 0
+
+
+def test_tracking_back_within_one_batch_is_not_lost(wave_take, stand_in):
+    """A stalled main thread drains a gap longer than the timeout followed by tracked frames: live goes on."""
+    now = [100.0]
+    applied = []
+    s = LiveSession(TakePlayback(wave_take), stand_in, applied.append, lost_tracking_timeout=0.5,
+                    clock=lambda: now[0])
+    s.running, s.start_clock = True, 0.0
+    s.source.status = "running"
+    for i in range(30):  # 1 s at 30 fps: tracked, then 0.9 s without anyone, then tracked again
+        states = wave_take.states[i] if i < 2 or i > 28 else np.zeros_like(wave_take.states[i])
+        s.queue.put(SkeletonFrame(wave_take.positions[i], states, i / 30.0, 100.0))
+    assert s.pump(), s.error
+    assert s.error is None and s.running and len(applied) == 1
+    # the same gap at the end of a batch still stops live
+    for i in range(30, 60):
+        s.queue.put(SkeletonFrame(wave_take.positions[i], np.zeros_like(wave_take.states[i]), i / 30.0, 100.0))
+    assert not s.pump() and "no tracked joints" in s.error
