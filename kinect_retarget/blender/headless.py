@@ -11,16 +11,32 @@ from .bake_take import bake_take, new_generated_rig
 
 
 def find_armature(name: str | None) -> bpy.types.Object:
+    """The named armature, or the only one, or the only one visible in the view layer (a Rigify file holds
+    the hidden metarig beside the generated rig)."""
     arms = [o for o in bpy.data.objects if o.type == "ARMATURE"]
+    listing = ", ".join(o.name for o in arms) or "none"
     if name:
         obj = bpy.data.objects.get(name)
         if obj is None or obj.type != "ARMATURE":
-            raise ValueError(f"no armature named {name!r} (armatures: {', '.join(o.name for o in arms) or 'none'})")
+            raise ValueError(f"no armature named {name!r} (armatures: {listing})")
         return obj
+    if len(arms) > 1:
+        view_layer = bpy.context.view_layer
+        visible = [o for o in arms if o.name in view_layer.objects and o.visible_get(view_layer=view_layer)]
+        arms = visible if len(visible) == 1 else arms
     if len(arms) != 1:
-        raise ValueError(f"{len(arms)} armatures in the file ({', '.join(o.name for o in arms) or 'none'}): "
-                         "name one with --armature")
+        raise ValueError(f"{len(arms)} armatures in the file ({listing}): name one with --armature")
     return arms[0]
+
+
+def open_blend(path: str) -> None:
+    """Open a .blend, with a one-line error for a missing or unreadable file."""
+    if not os.path.isfile(path):
+        raise ValueError(f"{path}: rig file not found")
+    try:
+        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(path), load_ui=False)
+    except RuntimeError as exc:
+        raise ValueError(f"{path}: not a readable .blend file ({str(exc).strip().splitlines()[-1]})") from None
 
 
 def bake_to_file(take: Take, out_path: str, *, rig_path: str | None = None, armature: str | None = None,
@@ -29,9 +45,7 @@ def bake_to_file(take: Take, out_path: str, *, rig_path: str | None = None, arma
     """Bake onto the armature of rig_path (or a generated Kinect rig) and save out_path. Returns a summary."""
     messages: list[str] = []
     if rig_path:
-        if not os.path.isfile(rig_path):
-            raise ValueError(f"{rig_path}: rig file not found")
-        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(rig_path), load_ui=False)
+        open_blend(rig_path)
         obj = find_armature(armature)
     else:
         bpy.ops.wm.read_factory_settings(use_empty=True)

@@ -77,13 +77,18 @@ def write(path: str | os.PathLike, take: Take) -> None:
 
 def read(path: str | os.PathLike) -> Take:
     path = os.fspath(path)
-    with open(path, "r", encoding="utf-8") as fh:
-        first = fh.readline()
-        body = fh.read()
+    try:
+        with open(path, "r", encoding="utf-8") as fh:
+            first = fh.readline()
+            body = fh.read()
+    except UnicodeDecodeError as exc:
+        raise TakeError(f"{path}: not a text take (byte {exc.start} is not UTF-8)") from None
     try:
         header = json.loads(first)
     except json.JSONDecodeError as exc:
         raise TakeError(f"{path}:1: take header is not valid JSON ({exc.msg})") from None
+    if not isinstance(header, dict):
+        raise TakeError(f"{path}:1: take header must be a JSON object")
     if header.get("format") != MAGIC:
         raise TakeError(f"{path}:1: not a kinect_retarget take (format field is {header.get('format')!r})")
     if header.get("version") != VERSION:
@@ -112,8 +117,14 @@ def read(path: str | os.PathLike) -> Take:
     if np.any((states != np.round(states)) | (states < 0) | (states > 2)):
         bad = int(np.argmax(np.any((states != np.round(states)) | (states < 0) | (states > 2), axis=1)))
         raise TakeError(f"{path}:{bad + 2}: tracking states must be 0, 1 or 2")
-    take = _make(path, skeleton, block[..., :3], states.astype(np.uint8), values[:, 0],
-                 float(header.get("rate", 30.0)), header.get("metadata", {}))
+    try:
+        rate = float(header.get("rate", 30.0))
+    except (TypeError, ValueError):
+        raise TakeError(f"{path}:1: rate must be a number, got {header.get('rate')!r}") from None
+    metadata = header.get("metadata", {})
+    if not isinstance(metadata, dict):
+        raise TakeError(f"{path}:1: metadata must be a JSON object")
+    take = _make(path, skeleton, block[..., :3], states.astype(np.uint8), values[:, 0], rate, metadata)
     if warnings_:
         take.metadata["warnings"] = warnings_
     return take

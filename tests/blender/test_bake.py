@@ -216,3 +216,26 @@ def test_euler_and_axis_angle_bones_are_keyed_in_their_own_channels(bpy_empty, s
     pairs = {b: (sk.joints[sk.parents[sk.index(b)]], b) for b in list(modes) + ["HandLeft", "AnkleLeft"]}
     errs = _check_directions(bpy, obj, res.motion, take, pairs, every=4)
     assert errs.max() < 0.5
+
+
+def test_cli_rig_errors_and_visible_armature(bpy_empty, shared_data, tmp_path):
+    from kinect_retarget.blender.bake_take import new_generated_rig
+    bpy = bpy_empty
+    take_path = shared_data / "kinect_v2" / "Ges04_comehere.csv"
+    take = load_take(take_path)
+    keep = new_generated_rig(bpy.context.scene, take, name="Visible")
+    hidden = new_generated_rig(bpy.context.scene, take, name="Hidden")
+    hidden.hide_set(True)
+    rig = tmp_path / "two.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(rig))
+    out = tmp_path / "out.blend"
+    r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(take_path), "--rig", str(rig),
+                        "--out", str(out)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert '"armature": "Visible"' in r.stdout and keep.name == "Visible"
+    junk = tmp_path / "junk.blend"
+    junk.write_text("not a blend file")
+    r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(take_path), "--rig", str(junk),
+                        "--out", str(out)], capture_output=True, text=True)
+    assert r.returncode == 2 and "junk.blend: not a readable .blend file" in r.stderr
+    assert "Traceback" not in r.stderr

@@ -25,3 +25,18 @@ def test_truncated_line_in_the_middle_is_an_error(tmp_path):
     bad.write_text("".join(lines))
     with pytest.raises(TakeError, match=r"bad.krtake:6: expected 101 values"):
         load_take(bad)
+
+
+@pytest.mark.parametrize("content, message", [
+    (b"\xff\xfe\x00garbage", "not a text take"),
+    (b'["kinect_retarget.take"]\n', "header must be a JSON object"),
+    (b'{"format": "kinect_retarget.take", "version": 1, "skeleton": "kinect_v1", "rate": "fast"}\n'
+     + b"0 " + b"0 0 2 2 " * 20 + b"\n", "rate must be a number"),
+])
+def test_bad_headers_name_the_file(tmp_path, content, message):
+    from kinect_retarget.takes import krtake
+    bad = tmp_path / "bad.krtake"
+    bad.write_bytes(content)
+    with pytest.raises(TakeError, match=message) as info:
+        krtake.read(bad)
+    assert "bad.krtake" in str(info.value)
