@@ -11,7 +11,7 @@ from bpy.utils import escape_identifier
 
 from ..core.kinect_rig_layout import median_segment_lengths
 from ..core.pipeline import BakedMotion, RetargetPipeline, RetargetSettings
-from ..core.presets import RIGIFY_FK_SWITCHES, build_mapping
+from ..core.presets import RIGIFY_FK_SWITCHES, build_mapping, mapping_problems
 from ..core.take import Take
 from .bake import bake_motion
 from .evaluated_solve import correct_for_evaluation
@@ -57,6 +57,8 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
     """
     settings = settings or RetargetSettings()
     pipeline, used = make_pipeline(obj, take, preset, overrides, settings)
+    for problem in mapping_problems(pipeline.rig.bone_names, overrides):
+        report({"WARNING"}, problem)
     motion = pipeline.process_take(take)
     if progress:
         progress(0.3)

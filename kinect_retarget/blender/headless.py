@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import os
+import sys
 
 import bpy
 
@@ -52,8 +53,11 @@ def bake_to_file(take: Take, out_path: str, *, rig_path: str | None = None, arma
         obj = new_generated_rig(bpy.context.scene, take)
         preset = "kinect" if preset == "auto" else preset
     bpy.context.view_layer.objects.active = obj
-    result = bake_take(obj, take, preset=preset, overrides=overrides, settings=settings,
-                       report=lambda level, msg: messages.append(msg))
+    def report(level, msg):
+        messages.append(msg)
+        if "WARNING" in level:
+            print(f"warning: {msg}", file=sys.stderr)
+    result = bake_take(obj, take, preset=preset, overrides=overrides, settings=settings, report=report)
     os.makedirs(os.path.dirname(os.path.abspath(out_path)), exist_ok=True)
     bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out_path), check_existing=False)
     return {"out": out_path, "armature": obj.name, "preset": result.preset, "action": result.action.name,

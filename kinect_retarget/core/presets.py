@@ -96,6 +96,22 @@ def load_mapping_file(path: str | os.PathLike) -> dict[str, str]:
     return {k: (v or "") for k, v in data.items()}
 
 
+KNOWN_JOINTS = frozenset(KINECT_V1.joints) | frozenset(KINECT_V2.joints)
+
+
+def mapping_problems(bone_names, overrides: dict[str, str] | None) -> list[str]:
+    """Sentences about user overrides that cannot take effect: a bone the armature lacks, a joint name that is
+    no Kinect joint (a typo would otherwise leave the bone silently at rest)."""
+    names, problems = set(bone_names), []
+    for bone, spec in (overrides or {}).items():
+        if bone not in names:
+            problems.append(f"mapping names bone {bone!r}, which the armature does not have")
+        for joint in (s.strip() for s in (spec or "").split(">") if s.strip()):
+            if joint not in KNOWN_JOINTS:
+                problems.append(f"mapping {bone!r} -> {joint!r}: no Kinect joint has that name")
+    return problems
+
+
 def build_mapping(preset: str, bone_names, overrides: dict[str, str] | None = None) -> tuple[str, dict]:
     """(preset actually used, mapping) for an armature's bones; overrides win, '' unmaps."""
     used = detect_preset(bone_names) if preset == "auto" else preset

@@ -182,6 +182,14 @@ def test_mirror_swaps_sides(hop):
     np.testing.assert_allclose(pb[:, left, :3, 1], pa[:, right, :3, 1] * flip, atol=1e-9)
 
 
+def test_mapping_typos_are_reported():
+    from kinect_retarget.core.presets import mapping_problems
+    problems = mapping_problems(["upper_arm.L", "forearm.L"], {"upper_arm.L": "ElbowLeftt", "hand.X": "HandLeft",
+                                                               "forearm.L": "ElbowLeft>WristLeft"})
+    assert problems == ["mapping 'upper_arm.L' -> 'ElbowLeftt': no Kinect joint has that name",
+                        "mapping names bone 'hand.X', which the armature does not have"]
+
+
 def test_presets_detect_and_override():
     assert detect_preset(list(RIGIFY_METARIG)) == "rigify-metarig"
     assert detect_preset(list(MAKEHUMAN) + ["toe1-1.L"]) == "makehuman"
