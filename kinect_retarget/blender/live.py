@@ -51,14 +51,18 @@ class LiveController:
         self.baked_action: str | None = None
         self.started_at = time.perf_counter()
         self._saved = _save_state(obj)
-        self._rigify_fk(obj)
-        pipeline = session.pipeline
-        corrector = ConstrainedParentCorrection(pipeline.rig, pipeline.bone_names, _constrained_bones(obj)) \
-            if hasattr(pipeline, "rig") else None
-        self.corrector = corrector if corrector is not None and corrector.active else None
-        self.update_after_apply = bool(bpy.app.background)
-        if self.corrector is not None:
-            self._read = [(b, pipeline.rig.bone_names[b]) for b in self.corrector.read]
+        try:
+            self._rigify_fk(obj)
+            pipeline = session.pipeline
+            corrector = ConstrainedParentCorrection(pipeline.rig, pipeline.bone_names, _constrained_bones(obj)) \
+                if hasattr(pipeline, "rig") else None
+            self.corrector = corrector if corrector is not None and corrector.active else None
+            self.update_after_apply = bool(bpy.app.background)
+            if self.corrector is not None:
+                self._read = [(b, pipeline.rig.bone_names[b]) for b in self.corrector.read]
+        except Exception:
+            _restore_state(obj, self._saved, keep_animation=False)  # the rig must not stay half-switched
+            raise
 
     # -- helpers -------------------------------------------------------------------------------------------
     def obj(self):
@@ -338,7 +342,7 @@ def start_live(context, source=None, use_timer: bool = True) -> LiveController:
     session.apply = controller.apply
     try:
         session.start()
-    except SourceError:
+    except Exception:  # any failure: the rig gets its pose and action back before the error goes up
         _restore_state(obj, controller._saved, keep_animation=False)
         raise
     _controller = controller

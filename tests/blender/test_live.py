@@ -383,3 +383,23 @@ def test_invoke_without_a_window_runs_on_the_timer(scene_with_rig):
     assert live.controller() is not None and bpy.app.timers.is_registered(live._timer)
     assert bpy.ops.kinect_retarget.live_stop() == {"FINISHED"}
     assert live.controller() is None and not bpy.app.timers.is_registered(live._timer)
+
+
+def test_a_source_failing_with_any_exception_restores_the_rig(scene_with_rig):
+    scene, obj, take, _ = scene_with_rig
+    user_action = bpy.data.actions.new("UserAction")
+    obj.animation_data_create().action = user_action
+    obj.pose.bones["ElbowLeft"].rotation_quaternion = (0.9, 0.1, 0.3, 0.0)
+    before = pose_quats(obj, [b.name for b in obj.pose.bones])
+
+    class Broken(FrameSource):
+        kind = "broken"
+
+        def _open(self):
+            raise RuntimeError("driver crashed")
+
+    with pytest.raises(RuntimeError, match="driver crashed"):
+        live.start_live(bpy.context, source=Broken(take.skeleton, 30.0), use_timer=False)
+    assert live.controller() is None
+    assert obj.animation_data.action == user_action
+    np.testing.assert_allclose(pose_quats(obj, [b.name for b in obj.pose.bones]), before, atol=1e-6)
