@@ -29,6 +29,29 @@ def test_no_blender_imports_outside_blender_package():
     assert not offenders, "Blender imports outside kinect_retarget/blender/: " + "; ".join(offenders)
 
 
+PURE_PACKAGES = ("core", "takes", "device", "sources", "live", "depth", "autorig", "lift")
+
+
+def _relative_targets(path: Path):
+    """Absolute module names of a file's relative imports (`from ..blender import x` -> kinect_retarget.blender)."""
+    rel = path.relative_to(PACKAGE.parent).with_suffix("")
+    package = list(rel.parts[:-1])
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom) and node.level > 0:
+            base = package[: len(package) - node.level + 1]
+            yield ".".join(base + ([node.module] if node.module else []))
+
+
+def test_pure_packages_never_reach_the_blender_package():
+    offenders = []
+    for pkg in PURE_PACKAGES:
+        for path in (PACKAGE / pkg).rglob("*.py"):
+            bad = [t for t in _relative_targets(path) if t.startswith("kinect_retarget.blender")]
+            if bad:
+                offenders.append(f"{path.relative_to(PACKAGE)}: {bad}")
+    assert not offenders, "bpy-free packages importing kinect_retarget.blender: " + "; ".join(offenders)
+
+
 def test_core_imports_without_bpy():
     import subprocess
     import sys
