@@ -113,7 +113,7 @@ class LiveController:
     def pump(self) -> bool:
         alive = self.session.pump()
         if not alive:
-            self.finish(bake=True)
+            self.finish()
         return alive
 
     # -- recording ---------------------------------------------------------------------------------------------
@@ -203,9 +203,17 @@ class LiveController:
                           f"root scale {cal.root_scale:.3f}")
 
     # -- stopping --------------------------------------------------------------------------------------------
-    def finish(self, bake: bool = True, context=None) -> None:
-        """Every stop path ends here: thread, recording (kept, baked when asked), pose, timer."""
+    def bake_on_stop(self) -> bool:
+        """The scene's *Bake on Stop*: every stop path that does not say otherwise follows it."""
+        scene = self.scene()
+        return bool(scene.kinect_retarget.bake_on_stop) if scene is not None else False
+
+    def finish(self, bake: bool | None = None, context=None) -> None:
+        """Every stop path ends here: thread, recording (kept; baked when asked, by default when the scene's
+        Bake on Stop is on), pose, timer."""
         global _controller
+        if bake is None:
+            bake = self.bake_on_stop()
         session = self.session
         session.stop()
         if self.recording is not None:
@@ -285,7 +293,7 @@ def _timer():
         alive = c.pump()
     except Exception as exc:  # never let a timer die with live half-running
         c.session.stop(f"unexpected {type(exc).__name__}: {exc}")
-        c.finish(bake=True)
+        c.finish()
         alive = False
     if not alive:
         return None
@@ -358,7 +366,8 @@ def pump_live() -> bool:
     return c.pump() if c is not None else False
 
 
-def stop_live(bake: bool = True, context=None) -> None:
+def stop_live(bake: bool | None = None, context=None) -> None:
+    """Stop live; `bake` None follows the scene's Bake on Stop."""
     if _controller is not None:
         _controller.finish(bake=bake, context=context)
 
@@ -412,6 +421,8 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
         s.initialised = True
         s.armature, s.preset, s.filter, s.root, s.mirror = obj, preset, filter_name, root, mirror
         s.play_on_record = False
+        # the command bakes what it records, also when the source ends first
+        user_bake_on_stop, s.bake_on_stop = s.bake_on_stop, bool(record)
         if overrides:
             fill_table(s, overrides)
         try:
@@ -425,6 +436,7 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
             time.sleep(0.002)
         elapsed = time.perf_counter() - start
         stop_live(bake=bool(record))
+        s.bake_on_stop = user_bake_on_stop  # the saved file keeps the user's setting
         result = {"seconds": round(elapsed, 3), "armature": obj.name, **c.session.statistics(),
                   "error": c.session.error, "record": os.path.abspath(record) if record else None,
                   "action": c.baked_action}
@@ -489,7 +501,7 @@ class KINECT_RETARGET_OT_live_start(bpy.types.Operator):
     def modal(self, context, event):
         if event.type == "ESC" and event.value == "PRESS" and _controller is self._ctrl:
             _flush_reports(self)
-            stop_live(bake=True, context=context)
+            stop_live(context=context)
         if _controller is not self._ctrl or self._ctrl is None:
             for level, msg in (self._ctrl.reports if self._ctrl else []):
                 self.report({level}, msg)
@@ -501,7 +513,7 @@ class KINECT_RETARGET_OT_live_start(bpy.types.Operator):
 
 
 class KINECT_RETARGET_OT_live_stop(bpy.types.Operator):
-    """Stop live; a recording in progress is kept and baked"""
+    """Stop live; a recording in progress is kept, and baked when Bake on Stop is on"""
     bl_idname = "kinect_retarget.live_stop"
     bl_label = "Stop Live"
     bl_options = {"REGISTER"}
@@ -512,7 +524,7 @@ class KINECT_RETARGET_OT_live_stop(bpy.types.Operator):
 
     def execute(self, context):
         c = _controller
-        stop_live(bake=True, context=context)
+        stop_live(context=context)
         for level, msg in c.reports:
             self.report({level}, msg)
         c.reports.clear()

@@ -403,3 +403,25 @@ def test_a_source_failing_with_any_exception_restores_the_rig(scene_with_rig):
     assert live.controller() is None
     assert obj.animation_data.action == user_action
     np.testing.assert_allclose(pose_quats(obj, [b.name for b in obj.pose.bones]), before, atol=1e-6)
+
+
+@pytest.mark.parametrize("how", ["take_ends", "stop_operator", "source_error"])
+def test_bake_on_stop_off_keeps_the_recording_unbaked_on_every_stop_path(scene_with_rig, how):
+    scene, obj, take, path = scene_with_rig
+    scene.kinect_retarget.bake_on_stop = False
+    scene.kinect_retarget.loop = how != "take_ends"
+    c = live.start_live(bpy.context, use_timer=False)
+    c.start_recording(bpy.context)
+    rec_path = c.recording["path"]
+    assert wait_for(lambda: c.session.stats.recorded >= 5)
+    if how == "stop_operator":
+        assert bpy.ops.kinect_retarget.live_stop() == {"FINISHED"}
+    elif how == "source_error":
+        os.remove(path)  # the looping reader notices within 30 frames
+        run_live()
+        assert "vanished" in live.status()["error"]
+    else:
+        run_live()
+    assert live.controller() is None
+    assert krtake.read(rec_path).frame_count >= 5
+    assert c.baked_action is None and (obj.animation_data is None or obj.animation_data.action is None)
