@@ -5,23 +5,18 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 from bpy_extras.io_utils import ImportHelper
 
-from ..core.filters import FILTERS
 from ..core.pipeline import RetargetSettings
-from ..core.presets import PRESET_NAMES, load_mapping_file
-from ..core.retarget import ROOT_MODES
+from ..core.presets import load_mapping_file
 from ..core.take import TakeError
 from ..takes import load_take
 from .bake_take import bake_take, take_display_name
-
-PRESET_ITEMS = [(p, p, f"Bone-mapping preset {p}") for p in PRESET_NAMES]
-FILTER_ITEMS = [(f, f, f"Jitter filter {f}") for f in FILTERS]
-ROOT_ITEMS = [("xyz", "XYZ", "Root follows the performer in all axes"),
-              ("xy", "XY", "Horizontal root motion only"), ("none", "None", "Root stays in place")]
-assert tuple(r[0] for r in ROOT_ITEMS) == ROOT_MODES
+from .mapping_ui import table_overrides
+from .preferences import FILTER_ITEMS
+from .properties import PRESET_ITEMS, ROOT_ITEMS, target_armature
 
 
 class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper):
-    """Bake a recorded take (Kinect CSV/JSON, NTU, MSRC-12, UTKinect, BVH, .krtake) onto the active armature"""
+    """Bake a recorded take (Kinect CSV/JSON, NTU, MSRC-12, UTKinect, BVH, .krtake) onto the target armature"""
 
     bl_idname = "kinect_retarget.bake_take"
     bl_label = "Bake Take"
@@ -38,19 +33,30 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper):
 
     @classmethod
     def poll(cls, context):
-        obj = context.active_object
-        if obj is None or obj.type != "ARMATURE":
+        if _target(context) is None:
             cls.poll_message_set("Select an armature to bake onto")
             return False
         return True
 
+    def invoke(self, context, event):
+        # start from the sidebar's choices; the file browser shows them for this bake
+        s = getattr(context.scene, "kinect_retarget", None)
+        if s is not None:
+            self.preset, self.filter, self.root, self.mirror = s.preset, s.filter, s.root, s.mirror
+        return super().invoke(context, event)
+
     def execute(self, context):
-        obj = context.active_object
+        obj = _target(context)
         wm = context.window_manager
         try:
             take = load_take(self.filepath)
             take.metadata.setdefault("name", take_display_name(self.filepath))
-            overrides = load_mapping_file(bpy.path.abspath(self.mapping_file)) if self.mapping_file else None
+            # the sidebar's mapping table, then a mapping file on top
+            s = getattr(context.scene, "kinect_retarget", None)
+            table = (table_overrides(s) or {}) if s is not None else {}
+            overrides = {b: j for b, j in table.items() if b in obj.pose.bones}  # rows for this rig only
+            if self.mapping_file:
+                overrides.update(load_mapping_file(bpy.path.abspath(self.mapping_file)))
             settings = RetargetSettings(filter=self.filter, root_mode=self.root, fps=self.fps or None,
                                         frame_start=self.frame_start, mirror=self.mirror)
         except (TakeError, ValueError) as exc:
@@ -58,7 +64,7 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper):
             return {"CANCELLED"}
         wm.progress_begin(0, 100)
         try:
-            bake_take(obj, take, preset=self.preset, overrides=overrides, settings=settings,
+            bake_take(obj, take, preset=self.preset, overrides=overrides or None, settings=settings,
                       report=self.report, progress=lambda x: wm.progress_update(int(100 * x)))
         except (TakeError, ValueError) as exc:
             self.report({"ERROR"}, str(exc))
@@ -66,6 +72,14 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper):
         finally:
             wm.progress_end()
         return {"FINISHED"}
+
+
+def _target(context):
+    """The sidebar's target armature when the add-on's settings exist, else the active armature."""
+    if getattr(context.scene, "kinect_retarget", None) is not None:
+        return target_armature(context)
+    obj = context.active_object
+    return obj if obj is not None and obj.type == "ARMATURE" else None
 
 
 CLASSES = (KINECT_RETARGET_OT_bake_take,)

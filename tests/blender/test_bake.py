@@ -239,3 +239,23 @@ def test_cli_rig_errors_and_visible_armature(bpy_empty, shared_data, tmp_path):
                         "--out", str(out)], capture_output=True, text=True)
     assert r.returncode == 2 and "junk.blend: not a readable .blend file" in r.stderr
     assert "Traceback" not in r.stderr
+
+
+def test_operator_uses_the_sidebar_target_and_mapping_table(registered, shared_data):
+    from kinect_retarget.blender.bake_take import new_generated_rig
+    bpy = registered
+    take_path = shared_data / "kinect_v2" / "Ges05_demopoint.csv"
+    take = load_take(take_path)
+    target = new_generated_rig(bpy.context.scene, take, name="Target")
+    other = new_generated_rig(bpy.context.scene, take, name="Other")
+    bpy.context.view_layer.objects.active = other
+    s = bpy.context.scene.kinect_retarget
+    s.armature = target
+    row = s.mapping.add()
+    row.bone, row.joint, row.enabled = "ElbowLeft", "ElbowLeft", False  # unmapped in the table
+    assert bpy.ops.kinect_retarget.bake_take(filepath=str(take_path), preset="kinect") == {"FINISHED"}
+    assert other.animation_data is None and target.animation_data.action is not None
+    from bpy_extras import anim_utils
+    paths = {fc.data_path for fc in anim_utils.animdata_get_channelbag_for_assigned_slot(target.animation_data).fcurves}
+    assert 'pose.bones["ElbowLeft"].rotation_quaternion' not in paths
+    assert 'pose.bones["WristLeft"].rotation_quaternion' in paths
