@@ -125,7 +125,8 @@ class LiveController:
             folder = bpy.path.abspath(s.record_dir or "//kinect_takes/")
             if folder.startswith("//") or not os.path.isabs(folder):  # unsaved file: // has no meaning
                 folder = os.path.join(bpy.app.tempdir or os.path.expanduser("~"), "kinect_takes")
-            path = os.path.join(folder, f"{bpy.path.clean_name(self.obj_name)}_{stamp}.krtake")
+            path, suffix = _unused_path(folder, f"{bpy.path.clean_name(self.obj_name)}_{stamp}", ".krtake")
+            stamp += suffix  # the action is named like its file
         name = f"{self.obj_name}_live_{stamp}"
         try:
             self.session.start_recording(path, {"name": name, "armature": self.obj_name,
@@ -232,6 +233,16 @@ class LiveController:
         if bpy.app.timers.is_registered(_timer):
             bpy.app.timers.unregister(_timer)
         _redraw()
+
+
+def _unused_path(folder: str, base: str, ext: str) -> tuple[str, str]:
+    """A file name in `folder` that does not exist yet: `base`, else `base_2`, `base_3`... (two recordings
+    started within one second must not overwrite each other). Returns the path and the suffix used."""
+    suffix, n = "", 1
+    while os.path.exists(os.path.join(folder, base + suffix + ext)):
+        n += 1
+        suffix = f"_{n}"
+    return os.path.join(folder, base + suffix + ext), suffix
 
 
 def _constrained_bones(obj) -> set[str]:

@@ -425,3 +425,20 @@ def test_bake_on_stop_off_keeps_the_recording_unbaked_on_every_stop_path(scene_w
     assert live.controller() is None
     assert krtake.read(rec_path).frame_count >= 5
     assert c.baked_action is None and (obj.animation_data is None or obj.animation_data.action is None)
+
+
+def test_recordings_started_in_the_same_second_get_their_own_files(scene_with_rig, monkeypatch):
+    scene, obj, take, _ = scene_with_rig
+    scene.kinect_retarget.loop = True
+    scene.kinect_retarget.bake_on_stop = False
+    monkeypatch.setattr(live.time, "strftime", lambda fmt: "20260101_120000")  # one second for all three
+    c = live.start_live(bpy.context, use_timer=False)
+    paths, counts = [], []
+    for _ in range(3):
+        paths.append(c.start_recording(bpy.context))
+        assert wait_for(lambda: c.session.recorder.frames >= 3)
+        counts.append(c.session.recorder.frames)
+        c.stop_recording(bake=False)
+    live.stop_live(bake=False)
+    assert len(set(paths)) == 3 and paths[1].endswith("_2.krtake") and paths[2].endswith("_3.krtake")
+    assert [krtake.read(p).frame_count for p in paths] == counts  # none overwritten
