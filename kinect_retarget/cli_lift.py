@@ -16,7 +16,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--focal", type=float, help="camera focal length in pixels (default: unknown, "
                                                "scaled orthographic; clips use their camera settings)")
     p.add_argument("--image-size", type=float, nargs=2, metavar=("W", "H"), help="video size in pixels")
-    p.add_argument("--height", type=float, default=1.70, help="performer's height in metres (bone lengths)")
+    p.add_argument("--height", type=float, default=None,
+                   help="performer's height in metres (bone lengths; default 1.70, or the --calibrate take's)")
     p.add_argument("--calibrate", metavar="TAKE", help="take of the same performer to measure bone lengths")
     p.add_argument("--fps", type=float, default=30.0, help="video frame rate (keypoint files carry none)")
     p.add_argument("--clip", help="Movie Clip name in the .blend (default: the only clip)")
@@ -52,9 +53,9 @@ def run_lift(args) -> int:
     lengths = None
     if args.calibrate:
         lengths = lengths_from_take(load_take(args.calibrate))
-        if args.height != 1.70:
+        if args.height is not None:  # an explicit height rescales the calibrated proportions
             lengths = lengths_scaled_to_height(lengths, args.height)
-    res = lift(tracks, LiftSettings(height_m=args.height, lengths=lengths, focal_px=focal, image_size=size,
+    res = lift(tracks, LiftSettings(height_m=args.height or 1.70, lengths=lengths, focal_px=focal, image_size=size,
                                     signs=args.signs))
     res.take.metadata["name"] = os.path.splitext(os.path.basename(os.path.normpath(args.out)))[0]
     krtake.write(args.out, res.take)

@@ -81,7 +81,8 @@ class RetargetPipeline:
         return self.retargeter.root.bone if self.retargeter.root else None
 
     def reset(self, rate: float = 30.0) -> None:
-        """Forget filter history and the root reference (a new take or a new live session)."""
+        """Forget filter history and the root reference (a new take or a new live session). The calibrated
+        source leg length (root scale) is kept: it belongs to the performer, not the take."""
         self.filter = make_filter(self.settings.filter, rate)
         self.root_reference: np.ndarray | None = None
         self._last_seen = np.full((len(self.skeleton), 3), np.nan)  # last finite position of each joint
