@@ -33,8 +33,9 @@ def target_rig_from_object(obj: bpy.types.Object) -> TargetRig:
 
 
 def has_constrained_ancestry(obj: bpy.types.Object, bone_names) -> bool:
-    """True when a mapped bone or one of its ancestors has constraints or drivers: its posed parent matrix
-    then depends on more than rest matrices and must be read back from Blender's evaluation."""
+    """True when an ancestor of a mapped bone has constraints or drivers: the mapped bone's posed parent
+    matrix then depends on more than rest matrices and must be read back from Blender's evaluation. (A mapped
+    bone's own constraints act after its keyed rotation, as the rig's author intended.)"""
     driven = set()
     ad = obj.animation_data
     if ad is not None:
