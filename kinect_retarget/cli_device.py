@@ -1,10 +1,11 @@
-"""Device commands: `devices`, `capture`, `tilt`, `led`, `accel` (plain Python; no Blender needed).
+"""Device commands of `python -m kinect_retarget`: `devices`, `capture`, `tilt`, `led`, `accel` (plain
+Python; no Blender needed). `--simulate` runs any of them against the emulated Kinect instead of USB hardware.
 
-`--simulate` runs any of them against the emulated Kinect instead of USB hardware.
+Exit codes follow the rest of the CLI: 2 for bad input (arguments, a missing or damaged file), 1 when the
+device fails (none found, no permission, unplugged, libusb missing, nothing captured).
 """
 from __future__ import annotations
 
-import argparse
 import json
 import queue
 import sys
@@ -15,9 +16,10 @@ import numpy as np
 
 from .device.calibration import Calibration
 from .device.decode import decode_frame
-from .device.errors import KinectError
+from .device.errors import BadInputFile, KinectError
 
 SIMULATE_HELP = "use the emulated Kinect instead of USB hardware"
+BAD_INPUT, DEVICE_FAILURE = 2, 1
 
 
 def add_parsers(sub) -> None:
@@ -73,8 +75,9 @@ def _backend(args):
 
 
 def _fail(exc: Exception) -> int:
+    """Print the reason and return the exit code: the user's input (2) or the device (1) is to blame."""
     print(f"error: {exc}", file=sys.stderr)
-    return 1
+    return BAD_INPUT if isinstance(exc, (BadInputFile, ValueError, OSError)) else DEVICE_FAILURE
 
 
 # --- devices ---------------------------------------------------------------------------------------------------
@@ -123,6 +126,8 @@ def _calibration_from(path: str) -> Calibration:
 def _capture_replay(args) -> int:
     from .device.dump import replay_dump
     frames, assembler, error = replay_dump(args.replay)
+    if error is not None and not frames:
+        raise error                    # nothing decoded (not a dump at all?): write no empty file
     # a dump holds packets only: the calibration comes from an earlier capture, else typical values
     calibration = _calibration_from(args.calibration) if args.calibration else Calibration()
     lut = calibration.raw_to_mm_table()
@@ -132,15 +137,19 @@ def _capture_replay(args) -> int:
     s = assembler.stats
     print(f"{len(frames)} frames decoded from {args.replay} ({s.packets_lost} packets lost, "
           f"{s.frames_missed} frames dropped) -> {args.out}")
-    if error is not None:
+    if error is not None:              # a damaged input file, even though what it held was saved
         print(f"warning: {error}; the frames before it were kept", file=sys.stderr)
-        return 1
+        return BAD_INPUT
     return 0
 
 
 def run_capture(args) -> int:
     if args.seconds <= 0 and not args.replay:
         return _fail(ValueError("--seconds must be positive"))
+    if args.wait < 0:
+        return _fail(ValueError("--wait must not be negative"))
+    if args.simulate_from and not args.simulate:
+        return _fail(ValueError("--simulate-from only applies to --simulate"))
     if args.calibration and not args.replay:
         return _fail(ValueError("--calibration only applies to --replay (a live capture reads the device's)"))
     try:
@@ -231,18 +240,3 @@ def run_accel(args) -> int:
     tilt = "unknown" if state.tilt_deg is None else f"{state.tilt_deg:g} degrees"
     print(f"accelerometer (g): x {x:+.3f}  y {y:+.3f}  z {z:+.3f}\ntilt: {tilt} ({state.status})")
     return 0
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m kinect_retarget.cli_device")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    add_parsers(sub)
-    args = parser.parse_args(argv)
-    try:
-        return int(args.handler(args) or 0)
-    except (ValueError, OSError) as exc:
-        return _fail(exc)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

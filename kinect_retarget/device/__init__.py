@@ -13,13 +13,13 @@ from .calibration import Calibration
 from .discovery import KinectInfo, find_kinect, list_devices
 from .emulated import EmulatedKinect
 from .emulated_stream import Faults, VirtualClock
-from .errors import (AccessDenied, DeviceGone, DeviceNotFound, DumpError, KinectError, LibusbMissing,
+from .errors import (AccessDenied, BadInputFile, DeviceGone, DeviceNotFound, DumpError, KinectError, LibusbMissing,
                      MotorUnavailable, ProtocolError)
 from .motor import KinectMotor, MotorState, open_motor, set_tilt
 from .preview import depth_preview
 from .stream import DepthFrame, DepthStream, StreamStatus
 
 __all__ = ["Calibration", "KinectInfo", "find_kinect", "list_devices", "EmulatedKinect", "Faults",
-           "VirtualClock", "AccessDenied", "DeviceGone", "DeviceNotFound", "DumpError", "KinectError",
+           "VirtualClock", "AccessDenied", "BadInputFile", "DeviceGone", "DeviceNotFound", "DumpError", "KinectError",
            "LibusbMissing", "MotorUnavailable", "ProtocolError", "KinectMotor", "MotorState", "open_motor",
            "set_tilt", "depth_preview", "DepthFrame", "DepthStream", "StreamStatus"]

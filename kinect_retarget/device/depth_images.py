@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from .calibration import mm_to_raw
-from .errors import KinectError
+from .errors import BadInputFile
 from .protocol import DEPTH_HEIGHT, DEPTH_WIDTH
 
 _PGM_HEADER = b"P5 640 480 65535\n"
@@ -17,15 +17,15 @@ def load_fakenect_pgm(path: str | Path) -> np.ndarray:
     path = Path(path)
     data = path.read_bytes()
     if not data.startswith(b"P5"):
-        raise KinectError(f"{path}: not a fakenect depth PGM (no 'P5' header)")
+        raise BadInputFile(f"{path}: not a fakenect depth PGM (no 'P5' header)")
     header_end = data.find(b"\n", data.find(b"65535")) + 1 if b"65535" in data[:32] else len(_PGM_HEADER)
     body = data[header_end:]
     expected = DEPTH_WIDTH * DEPTH_HEIGHT * 2
     if len(body) != expected:
-        raise KinectError(f"{path}: {len(body)} bytes of pixels, expected {expected} (truncated file?)")
+        raise BadInputFile(f"{path}: {len(body)} bytes of pixels, expected {expected} (truncated file?)")
     raw = np.frombuffer(body, dtype="<u2").reshape(DEPTH_HEIGHT, DEPTH_WIDTH)
     if raw.max() > 2047:
-        raise KinectError(f"{path}: values above 2047, so this is not raw 11-bit depth")
+        raise BadInputFile(f"{path}: values above 2047, so this is not raw 11-bit depth")
     return raw.astype(np.uint16)
 
 
@@ -33,7 +33,7 @@ def load_fakenect_dir(folder: str | Path, limit: int | None = None) -> list[np.n
     """All d-*.pgm depth frames of a fakenect recording, in recording order."""
     files = sorted(Path(folder).glob("d-*.pgm"))
     if not files:
-        raise KinectError(f"{folder}: no fakenect depth frames (d-*.pgm) found")
+        raise BadInputFile(f"{folder}: no fakenect depth frames (d-*.pgm) found")
     return [load_fakenect_pgm(f) for f in files[:limit]]
 
 

@@ -30,5 +30,9 @@ class MotorUnavailable(KinectError):
     """This Kinect's tilt motor, LED or accelerometer cannot be reached (see the message for why)."""
 
 
-class DumpError(KinectError):
+class BadInputFile(KinectError):
+    """A file the user gave (dump, fakenect recording) is missing or unusable: their input, not the device."""
+
+
+class DumpError(BadInputFile):
     """A packet dump file is unreadable (names the file and the record)."""

@@ -1,8 +1,12 @@
+"""The device commands through the real dispatcher (`python -m kinect_retarget`): 2 = bad input, 1 = device."""
 import json
+import subprocess
+import sys
 
 import numpy as np
+import pytest
 
-from kinect_retarget.cli_device import main
+from kinect_retarget.cli import main
 
 FAKENECT = "depth_real/fakenect_openiss/fakenect-record"
 
@@ -36,7 +40,7 @@ def test_capture_simulated_with_dump_then_replay(tmp_path, shared_data, capsys):
     np.testing.assert_array_equal(again["raw"][:n], live["raw"])
     np.testing.assert_array_equal(again["timestamp"][:n], live["timestamp"])
     np.testing.assert_array_equal(again["mm"][:n], live["mm"])
-    assert main(["capture", "--replay", str(dump), "--out", str(replayed), "--calibration", str(dump)]) == 1
+    assert main(["capture", "--replay", str(dump), "--out", str(replayed), "--calibration", str(dump)]) == 2
     assert "no usable calibration" in capsys.readouterr().err
 
 
@@ -48,13 +52,55 @@ def test_motor_commands_simulated(capsys):
     assert "accelerometer" in capsys.readouterr().out
 
 
-def test_errors_are_messages_not_tracebacks(tmp_path, capsys):
-    assert main(["capture", "--replay", str(tmp_path / "nope.dump"), "--out", str(tmp_path / "x.npz")]) == 1
+def test_bad_input_exits_2_with_a_message_not_a_traceback(tmp_path, capsys):
+    assert main(["capture", "--replay", str(tmp_path / "nope.dump"), "--out", str(tmp_path / "x.npz")]) == 2
     assert "no such dump file" in capsys.readouterr().err
     bad = tmp_path / "bad.dump"
     bad.write_bytes(b"\xff\xff\xff\xff garbage")
-    assert main(["capture", "--replay", str(bad), "--out", str(tmp_path / "y.npz")]) == 1
+    assert main(["capture", "--replay", str(bad), "--out", str(tmp_path / "y.npz")]) == 2
     assert "bad.dump" in capsys.readouterr().err
+    assert main(["capture", "--simulate", "--simulate-from", str(tmp_path), "--out", str(tmp_path / "e.npz")]) == 2
+    assert "no fakenect depth frames" in capsys.readouterr().err
+    assert main(["tilt", "--angle", "nan", "--simulate"]) == 2
+    assert "error:" in capsys.readouterr().err
+    for args, reason in ((["--seconds", "0"], "--seconds must be positive"),
+                         (["--wait", "-1"], "--wait must not be negative"),
+                         (["--calibration", str(bad)], "--calibration only applies to --replay"),
+                         (["--simulate-from", str(tmp_path)], "--simulate-from only applies to --simulate")):
+        assert main(["capture", "--out", str(tmp_path / "z.npz"), *args]) == 2
+        assert reason in capsys.readouterr().err
+    assert not list(tmp_path.glob("*.npz"))
+
+
+def test_truncated_dump_keeps_its_frames_and_exits_2(tmp_path, shared_data, capsys):
+    from kinect_retarget.device.dump import DumpWriter
+    from kinect_retarget.device.emulated_stream import packets_for_frames
+    from kinect_retarget.device.depth_images import load_fakenect_dir
+    dump = tmp_path / "cut.dump"
+    with DumpWriter(dump) as writer:
+        writer.write_packets(packets_for_frames(load_fakenect_dir(shared_data / FAKENECT, limit=3), 3))
+    dump.write_bytes(dump.read_bytes()[:-100])          # the last record loses its tail
+    out = tmp_path / "cut.npz"
+    assert main(["capture", "--replay", str(dump), "--out", str(out)]) == 2
+    assert "truncated" in capsys.readouterr().err
+    assert np.load(out)["raw"].shape[0] == 2              # the two whole frames before the damage
+
+
+@pytest.mark.parametrize("command, code, expected", [
+    (["devices", "--simulate", "--json"], 0, "Xbox 360 Kinect"),
+    (["accel", "--simulate"], 0, "accelerometer"),
+    (["capture", "--replay", "{tmp}/nope.dump", "--out", "{tmp}/x.npz"], 2, "no such dump file"),
+    (["capture", "--simulate", "--serial", "NOPE", "--wait", "0.2", "--out", "{tmp}/y.npz"], 1,
+     "no depth frame was captured"),
+])
+def test_python_dash_m_kinect_retarget(tmp_path, command, code, expected):
+    """The real entry point: output, exit code, and no traceback."""
+    argv = [a.format(tmp=tmp_path) for a in command]
+    done = subprocess.run([sys.executable, "-m", "kinect_retarget", *argv], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == code, done.stderr
+    assert expected in (done.stdout if code == 0 else done.stderr) and "Traceback" not in done.stderr
+    assert not list(tmp_path.glob("*.npz"))
 
 
 def test_capture_gives_up_when_no_kinect_streams(tmp_path, capsys, monkeypatch):

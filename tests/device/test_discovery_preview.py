@@ -58,7 +58,7 @@ def test_missing_libusb_is_a_clear_error(monkeypatch):
 
     import usb.backend.libusb1
 
-    from kinect_retarget.cli_device import main
+    from kinect_retarget.cli import main
     from kinect_retarget.device.errors import LibusbMissing
     from kinect_retarget.device.usb_backend import find_backend
 
@@ -73,4 +73,4 @@ def test_missing_libusb_is_a_clear_error(monkeypatch):
     monkeypatch.setattr(builtins, "__import__", no_libusb_package)
     with pytest.raises(LibusbMissing, match="libusb-1.0 could not be loaded"):
         find_backend()
-    assert main(["devices"]) == 1
+    assert main(["devices"]) == 1                  # a device-side failure, not bad input
