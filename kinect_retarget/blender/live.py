@@ -262,9 +262,13 @@ def _save_state(obj) -> dict:
              "ik_fk": {n: obj.pose.bones[n]["IK_FK"] for n in RIGIFY_FK_SWITCHES
                        if n in obj.pose.bones and "IK_FK" in obj.pose.bones[n]},
              "action": action.name if action else None,
-             "slot": ad.action_slot.identifier if action is not None and ad.action_slot else None}
+             "slot": ad.action_slot.identifier if action is not None and ad.action_slot else None,
+             "fake_user": action.use_fake_user if action is not None else False}
     if action is not None:
-        ad.action = None  # an assigned action would overwrite the live pose on every evaluation
+        # unassigned while live (it would overwrite the live pose on every evaluation), but held by a fake
+        # user so that saving during live, or a crash, does not drop it; the user's flag comes back on stop
+        action.use_fake_user = True
+        ad.action = None
     return state
 
 
@@ -274,8 +278,10 @@ def _restore_state(obj, state: dict, keep_animation: bool) -> None:
             obj.pose.bones[name]["IK_FK"] = value
     action = bpy.data.actions.get(state["action"]) if state["action"] else None
     if keep_animation:  # the baked recording now animates the rig
-        if action is not None and action.users == 0:
-            action.use_fake_user = True  # the rig's previous action must not vanish on the next save
+        if action is not None:
+            action.use_fake_user = state.get("fake_user", False)
+            if action.users == 0:
+                action.use_fake_user = True  # the rig's previous action must not vanish on the next save
         return
     restore_pose(obj, state["pose"])
     if action is not None:
@@ -284,6 +290,7 @@ def _restore_state(obj, state: dict, keep_animation: bool) -> None:
         slot = next((sl for sl in action.slots if sl.identifier == state["slot"]), None)
         if slot is not None:
             ad.action_slot = slot
+        action.use_fake_user = state.get("fake_user", False)
 
 
 def _redraw() -> None:

@@ -442,3 +442,19 @@ def test_recordings_started_in_the_same_second_get_their_own_files(scene_with_ri
     live.stop_live(bake=False)
     assert len(set(paths)) == 3 and paths[1].endswith("_2.krtake") and paths[2].endswith("_3.krtake")
     assert [krtake.read(p).frame_count for p in paths] == counts  # none overwritten
+
+
+def test_saving_during_live_keeps_the_users_action(scene_with_rig, tmp_path):
+    scene, obj, take, _ = scene_with_rig
+    scene.kinect_retarget.loop = True
+    user_action = bpy.data.actions.new("UserAction")
+    obj.animation_data_create().action = user_action
+    assert not user_action.use_fake_user
+    live.start_live(bpy.context, use_timer=False)
+    assert obj.animation_data.action is None
+    blend = str(tmp_path / "during_live.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=blend)  # Ctrl+S while live
+    live.stop_live(bake=False)
+    assert obj.animation_data.action == user_action and not user_action.use_fake_user  # the user's flag
+    bpy.ops.wm.open_mainfile(filepath=blend)
+    assert "UserAction" in bpy.data.actions  # the saved file did not drop it
