@@ -448,7 +448,10 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
         except SourceError as exc:
             raise ValueError(str(exc)) from None
         if record:
-            c.start_recording(bpy.context, os.path.abspath(record))
+            try:
+                c.start_recording(bpy.context, os.path.abspath(record))
+            except SourceError as exc:  # unwritable path: bad input, one line for the user
+                raise ValueError(str(exc)) from None
         start = time.perf_counter()
         while time.perf_counter() - start < seconds and pump_live():
             time.sleep(0.002)

@@ -108,3 +108,13 @@ def test_live_unknown_preset_or_filter_is_a_usage_error_not_a_traceback():
         proc = run_cli("--source", f"take:{SAMPLE}", "--seconds", "1", flag, "bogus")
         assert proc.returncode == 2, proc.stderr[-2000:]
         assert "invalid choice: 'bogus'" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_live_record_to_an_unwritable_path_is_one_error_line(tmp_path):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a folder")
+    proc = run_cli("--source", f"take:{SAMPLE}", "--seconds", "1", "--record", str(blocker / "rec.krtake"))
+    assert proc.returncode == 2, proc.stderr[-2000:]
+    assert "Traceback" not in proc.stderr and proc.stdout == ""
+    errors = [l for l in proc.stderr.splitlines() if l.startswith("error:")]
+    assert len(errors) == 1 and "cannot write the recording" in errors[0] and str(blocker) in errors[0]
