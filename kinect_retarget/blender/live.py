@@ -433,6 +433,9 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
         register()
         obj = build_kinect_rig(bpy.context.scene, source.skeleton, rig_lengths, "KinectRig")
         preset = "kinect" if preset == "auto" else preset
+        render = bpy.context.scene.render  # a new scene runs at the source's rate, as `bake` sets it
+        render.fps = max(1, int(round(source.rate)))
+        render.fps_base = render.fps / source.rate
     try:
         bpy.context.view_layer.objects.active = obj
         s = bpy.context.scene.kinect_retarget

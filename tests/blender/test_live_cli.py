@@ -118,3 +118,23 @@ def test_live_record_to_an_unwritable_path_is_one_error_line(tmp_path):
     assert "Traceback" not in proc.stderr and proc.stdout == ""
     errors = [l for l in proc.stderr.splitlines() if l.startswith("error:")]
     assert len(errors) == 1 and "cannot write the recording" in errors[0] and str(blocker) in errors[0]
+
+
+def test_live_generated_rig_runs_at_the_source_rate_one_key_per_frame(tmp_path):
+    import bpy
+
+    rec, out = tmp_path / "rec.krtake", tmp_path / "out.blend"
+    proc = run_cli("--source", f"take:{SAMPLE}", "--seconds", "30", "--record", str(rec), "--out", str(out))
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    stats = json.loads(proc.stdout)
+    bpy.ops.wm.open_mainfile(filepath=str(out), load_ui=False)
+    scene = bpy.context.scene
+    fps = scene.render.fps / scene.render.fps_base
+    assert fps == krtake.read(SAMPLE).rate == 30.0  # not Blender's factory 24
+    action = bpy.data.actions[stats["action"]]
+    curve = action.layers[0].strips[0].channelbag(action.slots[0]).fcurves.find(
+        'pose.bones["SpineMid"].rotation_quaternion', index=0)
+    times = krtake.read(rec).times
+    expected = len(np.unique(np.round((times - times[0]) * fps)))
+    assert len(curve.keyframe_points) == expected >= 0.95 * len(times)  # at 24 fps it would be ~0.8
+    bpy.ops.wm.read_factory_settings(use_empty=True)
