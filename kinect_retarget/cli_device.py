@@ -17,6 +17,7 @@ import numpy as np
 from .device.calibration import Calibration
 from .device.decode import decode_frame
 from .device.errors import BadInputFile, KinectError
+from .device.protocol import TICKS_PER_FRAME, TIMESTAMP_HZ
 
 SIMULATE_HELP = "use the emulated Kinect instead of USB hardware"
 BAD_INPUT, DEVICE_FAILURE = 2, 1
@@ -34,14 +35,16 @@ def add_parsers(sub) -> None:
     src.add_argument("--simulate", action="store_true", help=SIMULATE_HELP)
     src.add_argument("--replay", metavar="DUMP", help="decode a packet dump offline instead of streaming")
     p.add_argument("--simulate-from", metavar="DIR", help="fakenect recording (d-*.pgm) for --simulate")
-    p.add_argument("--seconds", type=float, default=5.0, help="how long to record (default 5)")
+    p.add_argument("--seconds", type=float, default=5.0,
+                   help="how much to record, in the Kinect's own time: 30 frames a second (default 5)")
     p.add_argument("--out", required=True, metavar="DEPTH.npz")
     p.add_argument("--dump", metavar="DUMP", help="also write every isochronous packet as received")
     p.add_argument("--calibration", metavar="DEPTH.npz",
                    help="with --replay: take the calibration from an earlier capture of the same Kinect")
     p.add_argument("--serial", help="which Kinect, when several are plugged in")
     p.add_argument("--wait", type=float, default=10.0, metavar="S",
-                   help="give up if streaming has not started after S seconds (default 10)")
+                   help="give up if streaming has not started after S seconds, or stop (keeping what was "
+                        "captured) when no frame came for S seconds (default 10)")
     p.set_defaults(handler=run_capture)
 
     p = sub.add_parser("tilt", help="tilt the Kinect (degrees from the horizon, -27..27)")
@@ -160,6 +163,13 @@ def run_capture(args) -> int:
         return _fail(exc)
 
 
+def _frame_ticks(timestamp: int, previous: int | None) -> int:
+    """Device time a new frame adds to a capture: the step from the previous frame (frames the device
+    dropped count too), or one frame period for the first frame and the first after a reconnect."""
+    step = (timestamp - previous) & 0xFFFFFFFF if previous is not None else TICKS_PER_FRAME
+    return step if 0 < step <= TIMESTAMP_HZ else TICKS_PER_FRAME
+
+
 def _capture_live(args) -> int:
     from .device.dump import DumpWriter
     from .device.stream import STREAMING, DepthStream
@@ -169,23 +179,30 @@ def _capture_live(args) -> int:
                          packet_hook=dump.write_packets if dump else None)
     raws, mms, stamps, lost = [], [], [], []
     calibration = Calibration()
-    last_message, started = "", None
-    asked = time.monotonic()
+    last_message, started, stalled = "", None, None
+    # the length counts device time (frame timestamps), so a busy computer still records all of it
+    wanted, recorded = round(args.seconds * TIMESTAMP_HZ), 0
+    asked = progress = time.monotonic()
     stream.start()
     try:
-        while started is None or time.monotonic() - started < args.seconds:
+        while recorded < wanted:
             status = stream.status
             if status.message != last_message:
                 print(f"[{status.state}] {status.message}", file=sys.stderr)
                 last_message = status.message
             if started is None and status.state == STREAMING:
-                started = time.monotonic()
+                started = progress = time.monotonic()
             if started is None and (status.state == "error" or time.monotonic() - asked > args.wait):
+                break
+            if started is not None and time.monotonic() - progress > args.wait:
+                stalled = f"no frame for {args.wait:g} s ({last_message})"
                 break
             try:
                 frame = stream.frames.get(timeout=0.05)
             except queue.Empty:
                 continue
+            recorded += _frame_ticks(frame.timestamp, stamps[-1] if stamps else None)
+            progress = time.monotonic()
             raws.append(frame.raw)
             mms.append(frame.mm)
             stamps.append(frame.timestamp)
@@ -203,6 +220,10 @@ def _capture_live(args) -> int:
     _save(args.out, raws, mms, stamps, lost, calibration)
     print(f"{len(raws)} frames -> {args.out} (dropped {status.frames_dropped}, "
           f"packets lost {status.packets_lost})" + (f"; packets -> {args.dump}" if dump else ""))
+    if stalled:                        # a device failure, even though what came before it was saved
+        print(f"error: {stalled}: {recorded / TIMESTAMP_HZ:.2f} of {args.seconds:g} s captured and saved",
+              file=sys.stderr)
+        return DEVICE_FAILURE
     return 0
 
 

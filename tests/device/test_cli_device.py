@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from kinect_retarget.cli import main
+from kinect_retarget.device.protocol import TICKS_PER_FRAME
 
 FAKENECT = "depth_real/fakenect_openiss/fakenect-record"
 
@@ -23,12 +24,27 @@ def test_udev_rule(capsys):
     assert "51-kinect.rules" in out and "udevadm" in out
 
 
-def test_capture_simulated_with_dump_then_replay(tmp_path, shared_data, capsys):
+def _emulator_on_a_virtual_clock(monkeypatch, faults=None):
+    """Make --simulate build an emulated Kinect whose time only it moves: what arrives is load-independent."""
+    from kinect_retarget.device import emulated
+    from kinect_retarget.device.emulated_stream import VirtualClock
+
+    class VirtualTimeKinect(emulated.EmulatedKinect):
+        def __init__(self, images, **kwargs):
+            super().__init__(images, clock=VirtualClock(), faults=faults, **kwargs)
+
+    monkeypatch.setattr(emulated, "EmulatedKinect", VirtualTimeKinect)
+
+
+def test_capture_simulated_with_dump_then_replay(tmp_path, shared_data, capsys, monkeypatch):
+    _emulator_on_a_virtual_clock(monkeypatch)
     out, dump = tmp_path / "depth.npz", tmp_path / "packets.dump"
     assert main(["capture", "--simulate", "--simulate-from", str(shared_data / FAKENECT), "--seconds", "0.5",
                  "--out", str(out), "--dump", str(dump)]) == 0
     live = np.load(out)
-    assert live["raw"].shape[1:] == (480, 640) and live["raw"].shape[0] >= 10
+    assert live["raw"].shape[1:] == (480, 640) and live["raw"].shape[0] == 15    # 0.5 s of device time
+    steps = np.diff(live["timestamp"]) & 0xFFFFFFFF
+    assert (steps == TICKS_PER_FRAME).all() and (live["lost_packets"] == 0).all()
     assert live["mm"].shape == live["raw"].shape and live["timestamp"].shape == (live["raw"].shape[0],)
     assert json.loads(str(live["calibration"]))["source"] == "device"
     replayed = tmp_path / "replayed.npz"
@@ -117,3 +133,14 @@ def test_capture_gives_up_when_no_kinect_streams(tmp_path, capsys, monkeypatch):
     out = tmp_path / "none.npz"
     assert main(["capture", "--simulate", "--seconds", "1", "--wait", "0.3", "--out", str(out)]) == 1
     assert "no Kinect found" in capsys.readouterr().err and not out.exists()
+
+
+def test_capture_keeps_its_frames_when_the_kinect_goes_and_stays_away(tmp_path, monkeypatch, capsys):
+    from kinect_retarget.device.emulated_stream import Faults
+    _emulator_on_a_virtual_clock(monkeypatch, Faults(unplug_at=0.21))     # after frames 0-5, for good
+    out = tmp_path / "cut.npz"
+    assert main(["capture", "--simulate", "--seconds", "2", "--wait", "0.3", "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "no frame for 0.3 s" in err and "0.20 of 2 s captured and saved" in err
+    kept = np.load(out)
+    assert kept["raw"].shape[0] == 6 and (np.diff(kept["timestamp"]) & 0xFFFFFFFF == TICKS_PER_FRAME).all()
