@@ -167,9 +167,13 @@ class LiveController:
             return
         pipeline = self.session.pipeline
         n = pipeline.retargeter.scale_for(pipeline.source_leg)  # the root scale live used
-        settings = replace(self.settings, fps=rec["fps"], frame_start=rec["frame_start"], root_scale=n)
         try:
             take = load_take(path)
+            # the take's times count from when recording started (not from its first sample): anchor the
+            # keys there, so the timeline (and audio played with it) lines up with what happened
+            start = rec["frame_start"] + int(round(float(take.times[0]) * rec["fps"])) if take.frame_count else \
+                rec["frame_start"]
+            settings = replace(self.settings, fps=rec["fps"], frame_start=start, root_scale=n)
             result = bake_take(obj, take, preset=self.preset, overrides=self.overrides, settings=settings,
                                action_name=rec["name"], set_scene_range=False,
                                report=lambda level, msg: self.post(next(iter(level)), msg))

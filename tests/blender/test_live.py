@@ -117,16 +117,16 @@ def test_live_poses_rig_records_and_bakes_at_timeline_frames(scene_with_rig):
     fc = action.layers[0].strips[0].channelbag(action.slots[0]).fcurves
     curve = fc.find('pose.bones["SpineMid"].rotation_quaternion', index=0)
     keys = np.array([k.co[0] for k in curve.keyframe_points])
-    assert keys[0] == 40
     rec = krtake.read(rec_path)
     fps = scene.render.fps / scene.render.fps_base
-    assert keys[-1] == 40 + round((rec.times[-1] - rec.times[0]) * fps)
+    assert keys[0] == 40 + round(rec.times[0] * fps)  # anchored where recording started
+    assert keys[-1] == keys[0] + round((rec.times[-1] - rec.times[0]) * fps)
     # live equals baked: each applied pose is the action's value at that sample's frame
     names = seen[0][0].bone_names
     for pose, held in seen[:: max(1, len(seen) // 8)]:
         i = int(np.argmin(np.abs(rec.times - pose.time)))
-        frame = 40 + round((rec.times[i] - rec.times[0]) * fps)
-        if i and frame == 40 + round((rec.times[i - 1] - rec.times[0]) * fps):
+        frame = int(keys[0]) + round((rec.times[i] - rec.times[0]) * fps)
+        if i and frame == keys[0] + round((rec.times[i - 1] - rec.times[0]) * fps):
             continue  # another sample owns this frame's key
         scene.frame_set(frame)
         assert np.degrees(angle_between(pose_quats(obj, names), pose.quats)).max() < 1e-3
@@ -458,3 +458,31 @@ def test_saving_during_live_keeps_the_users_action(scene_with_rig, tmp_path):
     assert obj.animation_data.action == user_action and not user_action.use_fake_user  # the user's flag
     bpy.ops.wm.open_mainfile(filepath=blend)
     assert "UserAction" in bpy.data.actions  # the saved file did not drop it
+
+
+def test_keys_are_anchored_at_the_frame_where_recording_started(scene_with_rig):
+    """The first sample arrives half a second after Record: its key lands half a second after that frame."""
+    scene, obj, take, _ = scene_with_rig
+    scene.frame_current = 40
+    gate = threading.Event()
+
+    class Late(_Scripted):
+        def _run(self):
+            gate.wait(30)
+            super()._run()
+
+    c = live.start_live(bpy.context, source=Late(take), use_timer=False)
+    c.start_recording(bpy.context)
+    rec_path = c.recording["path"]
+    wait_for(lambda: False, seconds=0.5)
+    gate.set()
+    run_live()
+    rec = krtake.read(rec_path)
+    fps = scene.render.fps / scene.render.fps_base
+    assert rec.times[0] >= 0.45
+    action = obj.animation_data.action
+    curve = action.layers[0].strips[0].channelbag(action.slots[0]).fcurves.find(
+        'pose.bones["SpineMid"].rotation_quaternion', index=0)
+    keys = np.array([k.co[0] for k in curve.keyframe_points])
+    assert keys[0] == 40 + round(rec.times[0] * fps) >= 40 + round(0.45 * fps)
+    assert keys[-1] == keys[0] + round((rec.times[-1] - rec.times[0]) * fps)
