@@ -24,6 +24,7 @@ GEODESIC_ROWS = 1000   # no subsampling below the tracker's grid: coarser cells 
 EXTREMA = "plagemann"     # "maxima" (one geodesic run) or "plagemann" (one run per extremum, slower)
 SIDES = ("Left", "Right")
 AXIS_GRAVITY_WEIGHT = 0.75  # torso axis = this blend of gravity's up and the torso patch's long axis
+SIDE_ON_WIDTH = 0.165       # visible chest width / height below which the torso is taken as seen side-on
 REACH_SLACK = 0.10          # m an extremity may lie beyond the limb's calibrated reach and still be its end
 
 
@@ -138,6 +139,8 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     if edge_on:  # seen nearly edge-on: the normal is unreliable, assume facing the sensor
         facing = _unit(-view - (-view @ axis) * axis)
     lat = _unit(np.cross(axis, facing))  # points to the performer's left
+    # the chest's normal always faces the sensor, even side-on; the chest's visible width does not lie
+    narrow = _visible_chest_width(xyz[mask], centre, axis, view, H) < SIDE_ON_WIDTH * H
     if prev_lateral is not None:
         if lat @ prev_lateral < 0:
             lat = -lat
@@ -282,7 +285,19 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     if facing @ -view < 0.7:
         for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
             st[J[name]] = INFERRED
-    return FitResult(pos, st, lat, labels, centre, None if head is None else head[1], proj, edge_on)
+    return FitResult(pos, st, lat, labels, centre, None if head is None else head[1], proj, edge_on or narrow)
+
+
+def _visible_chest_width(pts, centre, axis, view, H):
+    """Width across the image of the person at chest height (near the torso, arms far out excluded)."""
+    across = _unit(np.cross(axis, view))
+    rel = pts - centre
+    a, x = rel @ axis, rel @ across
+    band = x[(a > 0.0) & (a < 0.12 * H) & (np.abs(x) < 0.35)]
+    if len(band) < 10:
+        return np.inf
+    lo, hi = np.percentile(band, [5, 95])
+    return float(hi - lo)
 
 
 def _shoulder_top(xyz, mask, centre, axis, lat, H, expect):
