@@ -32,8 +32,14 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    from .device.errors import BadInputFile, KinectError
+    from .sources.base import SourceError
+
     try:
         return int(args.handler(args) or 0)
-    except (TakeError, ValueError, OSError) as exc:
+    except (TakeError, ValueError, OSError, BadInputFile) as exc:  # bad input: exit 2
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except (KinectError, SourceError) as exc:  # a device or source that failed while running: exit 1
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
