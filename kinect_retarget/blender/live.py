@@ -405,7 +405,7 @@ def status() -> dict:
         return dict(_last_status)
     src = c.session.source
     return {"state": "recording" if c.recording else "running", "message": c.message,
-            "error": src.error, "stats": c.session.statistics(), "tracked": c.session.last_tracked_joints,
+            "error": src.error, "warning": src.warning, "stats": c.session.statistics(), "tracked": c.session.last_tracked_joints,
             "joints": len(src.skeleton), "calibrating": c.session.calibrating,
             "device": getattr(src, "device_status", None),
             "progress": (src.position + 1, src.take.frame_count) if isinstance(src, TakePlayback) else None,
@@ -467,7 +467,9 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
         s.bake_on_stop = user_bake_on_stop  # the saved file keeps the user's setting
         result = {"seconds": round(elapsed, 3), "armature": obj.name, **c.session.statistics(),
                   "error": c.session.error, "record": os.path.abspath(record) if record else None,
-                  "action": c.baked_action}
+                  "action": c.baked_action, "warning": source.warning}
+        if hasattr(source, "bad_packets"):
+            result["bad_packets"] = source.bad_packets
         if out:
             os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
             bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out), check_existing=False)

@@ -63,6 +63,8 @@ class KINECT_RETARGET_PT_main(_KinectPanel, bpy.types.Panel):
             err = col.row()
             err.alert = True
             err.label(text=st["error"], icon="ERROR")
+        if st.get("warning") and not st.get("error"):
+            col.label(text=st["warning"], icon="ERROR")  # not fatal: live goes on
         stats = st.get("stats")
         if st.get("state") in ("running", "recording"):
             col.label(text=st.get("message", ""), icon="REC" if st["state"] == "recording" else "PLAY")

@@ -30,6 +30,7 @@ class FrameSource:
         self.rate = float(rate)
         self.status = "idle"           # idle | running | finished | stopped | error
         self.error: str | None = None
+        self.warning: str | None = None  # the latest problem the source got past (shown, not fatal)
         self.frames_emitted = 0
         self._queue: FrameQueue | None = None
         self._stop = threading.Event()

@@ -1,7 +1,9 @@
 """UDP/OSC receiver compatible with NI mate's skeleton stream ("Basic" format: one message per joint,
 `/<Joint_Name> x y z`, then `/NI_mate_sync`).
 
-Bound to 127.0.0.1 unless the user asks otherwise. Arguments are only ever read as numbers. A frame ends at
+Bound to 127.0.0.1 unless the user asks otherwise. Arguments are only ever read as numbers; a malformed
+packet is counted, shown (`warning`) and skipped, since one stray datagram must not end live; only socket
+errors stop the receiver. A frame ends at
 `/NI_mate_sync`, at the end of a bundle, or when a joint repeats (senders without sync markers).
 Positions are taken as Kinect camera space metres (NI mate's skeleton output; see docs/live.md).
 """
@@ -115,6 +117,7 @@ class OscReceiver(FrameSource):
         self.host, self.port = host, int(port)
         self.assembler = FrameAssembler(skeleton)
         self.packets = 0
+        self.bad_packets = 0
         self._sock: socket.socket | None = None
 
     def describe(self) -> str:
@@ -159,6 +162,7 @@ class OscReceiver(FrameSource):
                     frame = self.assembler.flush()
                     if frame is not None:
                         self._emit(frame[0], frame[1], time.perf_counter(), where=f" packet {self.packets}")
-            except OscError as exc:
-                raise SourceError(f"{self.describe()}: bad OSC packet {self.packets} from "
-                                  f"{sender[0]}:{sender[1]}: {exc}") from None
+            except OscError as exc:  # never evaluated, never fatal: count it, say which, go on
+                self.bad_packets += 1
+                self.warning = (f"{self.describe()}: {self.bad_packets} bad OSC packet(s) ignored; latest, "
+                                f"packet {self.packets} from {sender[0]}:{sender[1]}: {exc}")

@@ -140,14 +140,22 @@ def test_osc_receiver_end_to_end(rng):
     assert not src.alive
 
 
-def test_osc_garbage_packet_stops_the_source_with_its_reason():
+def test_osc_bad_packets_are_counted_and_shown_and_live_goes_on(rng):
     q = FrameQueue()
     src = OscReceiver(port=0)
     src.start(q)
-    _send(src.port, [b"\x13\x37garbage!"])
-    assert wait_until(lambda: src.status == "error")
-    src.stop()
-    assert "bad OSC packet" in src.error and "127.0.0.1" in src.error
+    try:
+        _send(src.port, [b"\x13\x37garbage!"])  # not OSC at all
+        assert wait_until(lambda: src.bad_packets == 1)
+        _send(src.port, [encode_message("/Head", "1", "2", "3")])  # strings: never read as anything else
+        assert wait_until(lambda: src.bad_packets == 2)
+        assert src.status == "running" and src.error is None and src.alive
+        assert "2 bad OSC packet" in src.warning and "packet 2" in src.warning and "127.0.0.1" in src.warning
+        _send(src.port, [encode_message("/Head", 1.0, 2.0, 3.0), encode_message("/NI_mate_sync", "x")])
+        assert wait_until(lambda: len(q) == 1)  # good frames after the bad ones still arrive
+    finally:
+        src.stop()
+    np.testing.assert_allclose(q.drain()[0].positions[KINECT_V2.index("Head")], [1, 2, 3])
     assert not src.alive
 
 
