@@ -73,7 +73,7 @@ class ConfidenceCheck:
         if len(found) < MIN_EXTREMITIES:   # not the shape of a person facing the sensor (side-on, curled up)
             doubt[LIMB + SIDE_TORSO] = True
         for chain in CHAINS:   # beyond a doubtful joint the chain hangs on a guess
-            bad = np.cumsum(doubt[chain] | (st[chain] != TRACKED)) > 0
+            bad = np.cumsum(doubt[chain]) > 0   # (an elbow the fit merely inferred leaves the hand its own evidence)
             doubt[chain] |= bad & (st[chain] == TRACKED)
         self._flag_age = np.where(doubt, 0, self._flag_age + 1)
         st[(self._flag_age <= RECOVERY_FRAMES) & (st == TRACKED)] = INFERRED

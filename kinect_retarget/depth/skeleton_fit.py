@@ -25,6 +25,7 @@ EXTREMA = "plagemann"     # "maxima" (one geodesic run) or "plagemann" (one run 
 SIDES = ("Left", "Right")
 AXIS_GRAVITY_WEIGHT = 0.75  # torso axis = this blend of gravity's up and the torso patch's long axis
 SIDE_ON_WIDTH = 0.165       # visible chest width / height below which the torso is taken as seen side-on
+MID_NEEDS_SUPPORT = True    # an elbow/knee is tracked only where the depth image backs it (projective check)
 REACH_SLACK = 0.10          # m an extremity may lie beyond the limb's calibrated reach and still be its end
 
 
@@ -276,7 +277,7 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
             if np.linalg.norm(reach_shift) > REACH_SLACK:
                 st_limb = INFERRED  # the extremity is out of this limb's reach: not its hand/foot, or a bad root
             mid_ok = st_limb == TRACKED and proj.supported(m, bm.DEPTH_INSIDE[mid] - 0.02)
-            st[J[f"{mid}{s}"]] = TRACKED if mid_ok or st_limb == TRACKED else INFERRED
+            st[J[f"{mid}{s}"]] = TRACKED if mid_ok or (st_limb == TRACKED and not MID_NEEDS_SUPPORT) else INFERRED
             st[J[f"{end}{s}"]] = st[J[f"{tip}{s}"]] = st_limb
     # without the head top or the shoulders the torso's place along its axis is a guess; seen more than
     # 45 degrees from the front, shoulders and hips overlap in depth: say so instead of claiming them
