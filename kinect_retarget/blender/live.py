@@ -463,6 +463,9 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
         while time.perf_counter() - start < seconds and pump_live():
             time.sleep(0.002)
         elapsed = time.perf_counter() - start
+        idle_reason = getattr(source, "idle_reason", None)
+        if c.session.stats.received == 0 and not c.session.error and idle_reason is not None:
+            c.session.stop(idle_reason())  # a device that delivered nothing is a failed run, not an empty one
         stop_live(bake=bool(record))
         s.bake_on_stop = user_bake_on_stop  # the saved file keeps the user's setting
         result = {"seconds": round(elapsed, 3), "armature": obj.name, **c.session.statistics(),

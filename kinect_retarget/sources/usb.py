@@ -45,6 +45,9 @@ def usb_status() -> str:
 class UsbKinectSource(FrameSource):
     kind = "usb"
     NO_FRAME_TIMEOUT = 5.0  # seconds without a depth frame (unplugged, no device) before live gives up
+    # stream states that will not heal by themselves (device.stream.ERROR: no libusb, no permission): the
+    # stream retries them slowly for a user fixing things, but live says so at once instead of waiting
+    FAILED_STATES = ("error",)
 
     def __init__(self, producer=None, factory=None):
         self._producer = producer
@@ -87,12 +90,22 @@ class UsbKinectSource(FrameSource):
             except Exception:
                 pass  # closing an unplugged device may fail; the thread is gone either way
 
+    def _stream_status(self):
+        return getattr(getattr(self._producer, "stream", None), "status", None)
+
     @property
     def device_status(self) -> str | None:
         """The depth stream's own sentence (connecting, streaming, unplugged...), when the producer has one."""
-        stream = getattr(self._producer, "stream", None)
-        status = getattr(stream, "status", None)
-        return getattr(status, "message", None)
+        return getattr(self._stream_status(), "message", None)
+
+    def device_failure(self) -> str | None:
+        """The stream's sentence when it is in a failed state, else None."""
+        status = self._stream_status()
+        return getattr(status, "message", None) if getattr(status, "state", None) in self.FAILED_STATES else None
+
+    def idle_reason(self) -> str | None:
+        """Why nothing arrived, for a run that ends before the no-frame timeout (headless `live`)."""
+        return f"{self.describe()}: no depth frame received ({self.device_status or 'no frames'})"
 
     def _run(self) -> None:
         n = 0
@@ -105,6 +118,9 @@ class UsbKinectSource(FrameSource):
             except Exception as exc:
                 raise SourceError(f"USB Kinect stopped delivering frames ({exc})") from None
             if frame is None:
+                failure = self.device_failure()
+                if failure:
+                    raise SourceError(f"USB Kinect: {failure}")
                 if time.monotonic() - last > self.NO_FRAME_TIMEOUT:
                     why = self.device_status or "no frames"
                     raise SourceError(f"USB Kinect: no depth frame for {self.NO_FRAME_TIMEOUT:.0f} s ({why})")

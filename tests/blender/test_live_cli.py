@@ -140,3 +140,13 @@ def test_live_generated_rig_runs_at_the_source_rate_one_key_per_frame(tmp_path):
     expected = len(np.unique(np.round((times - times[0]) * fps)))
     assert len(curve.keyframe_points) == expected >= 0.95 * len(times)  # at 24 fps it would be ~0.8
     bpy.ops.wm.read_factory_settings(use_empty=True)
+
+
+def test_live_usb_without_a_working_device_fails_with_the_reason():
+    """No libusb (fails at once) or no Kinect (nothing received before --seconds): exit 1 with the reason."""
+    proc = run_cli("--source", "usb", "--seconds", "2")
+    assert proc.returncode == 1, (proc.stdout, proc.stderr[-2000:])
+    stats = json.loads(proc.stdout)
+    assert stats["received"] == 0 and stats["error"].startswith("USB Kinect")
+    errors = [l for l in proc.stderr.splitlines() if l.startswith("error:")]
+    assert len(errors) == 1 and stats["error"] in errors[0] and "Traceback" not in proc.stderr

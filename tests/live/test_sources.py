@@ -277,3 +277,19 @@ def test_stop_keeps_a_thread_that_has_not_ended_and_start_refuses_a_second_one(r
     src.start(FrameQueue())  # the old reader has ended: a restart is fine
     src.stop()
     assert not src.alive
+
+
+def test_usb_fails_at_once_when_the_stream_is_in_a_failed_state(monkeypatch):
+    class NoLibusb(FakeProducer):
+        class stream:
+            class status:
+                state = "error"
+                message = "libusb-1.0 could not be loaded, so USB devices cannot be opened"
+
+    monkeypatch.setattr(UsbKinectSource, "NO_FRAME_TIMEOUT", 600.0)  # only the failed state can end it
+    src = UsbKinectSource(factory=lambda: NoLibusb([]))
+    src.start(FrameQueue())
+    assert wait_until(lambda: src.status == "error")
+    src.stop()
+    assert src.error == "USB Kinect: libusb-1.0 could not be loaded, so USB devices cannot be opened"
+    assert "no depth frame received" in src.idle_reason()
