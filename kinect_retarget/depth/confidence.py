@@ -4,10 +4,10 @@ The fit marks a joint TRACKED when it rests on evidence (torso patch, extremity,
 run after the fit, catch the cases where that evidence was misleading, as the SDK does: a joint that
 disagrees with the motion of the previous frames (a torso patch that slid, an extremity handed to the wrong
 limb), a limb joint that projects off the person or in front of the surface (occluded, or placed where the
-body is not), every limb when the torso is seen edge-on (the sides overlap in depth) or fewer than three of the five
-extremities show (side-on, curled up: what was found may be labelled wrongly), the hips when the head is not
-seen (the torso was then placed from the shoulders alone), and a joint that only
-just recovered from being flagged (one good frame is not yet evidence).
+body is not), every limb when the torso is seen edge-on (a narrow chest: the sides overlap in depth) or fewer
+than three of the five extremities show (side-on, curled up: what was found may be labelled wrongly), the hips
+when the head is not seen (the torso was then placed from the shoulders alone), and a joint that only just
+recovered from being flagged (one good frame is not yet evidence).
 """
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ J = {n: i for i, n in enumerate(KINECT_V1.joints)}
 TORSO = [J[n] for n in ("HipCenter", "Spine", "ShoulderCenter", "Head")]
 LOWER_TORSO = [J[n] for n in ("HipCenter", "Spine", "HipLeft", "HipRight")]
 SIDE_TORSO = [J[f"{p}{s}"] for p in ("Shoulder", "Hip") for s in ("Left", "Right")]
-# limb chains, root first: a demoted joint demotes everything beyond it
+# limb chains, root first: a doubted joint demotes everything beyond it
 CHAINS = [[J[f"{n}{s}"] for n in names] for s in ("Left", "Right")
           for names in (("Elbow", "Wrist", "Hand"), ("Knee", "Ankle", "Foot"))]
 LIMB = [j for chain in CHAINS for j in chain]
@@ -38,7 +38,7 @@ OFF_SURFACE = 0.2        # Projector.cost at or above this: off the person's sil
 
 
 class ConfidenceCheck:
-    """Per-tracker state (the last two fitted poses, recent flags) and the per-frame demotion."""
+    """Per-tracker state (the last two output poses, recent flags) and the per-frame demotion."""
 
     def __init__(self):
         self.reset()
