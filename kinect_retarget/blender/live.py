@@ -425,7 +425,10 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
     if rig_path:
         if not os.path.isfile(rig_path):
             raise ValueError(f"{rig_path}: rig file not found")
-        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(rig_path), load_ui=False)
+        try:
+            bpy.ops.wm.open_mainfile(filepath=os.path.abspath(rig_path), load_ui=False)
+        except RuntimeError as exc:  # not a .blend, or a damaged one: Blender says which
+            raise ValueError(f"{rig_path}: cannot open the rig ({_blender_message(exc)})") from None
         register()
         try:
             obj = find_armature(armature)
@@ -475,12 +478,19 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
             result["bad_packets"] = source.bad_packets
         if out:
             os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
-            bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out), check_existing=False)
+            try:
+                bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out), check_existing=False)
+            except RuntimeError as exc:  # the recording (if any) is already on disk
+                raise ValueError(f"{out}: cannot save ({_blender_message(exc)})") from None
             result["out"] = os.path.abspath(out)
     finally:
         stop_live(bake=False)
         unregister()
     return result
+
+
+def _blender_message(exc: Exception) -> str:
+    return str(exc).strip().removeprefix("Error: ").strip()
 
 
 # -- operators -----------------------------------------------------------------------------------------------
