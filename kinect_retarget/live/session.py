@@ -161,7 +161,7 @@ class LiveSession:
                 self.last_pose = pose
                 self.stats.applied += 1
                 self.stats.latency.add(self.clock() - frame.arrival)
-        if self.source.error:
+        if self.source.error and len(self.queue) == 0:  # frames sent before the failure are recorded first
             self.stop(self.source.error)
             return False
         if not self.source.alive and self.source.status != "running" and len(self.queue) == 0:
