@@ -6,8 +6,9 @@ joint, paper step 1); X comes from a second, sideways vector (paper step 2-3: X 
 
 * torso, neck, head, pelvis: AB is the left-right line of the hips or shoulders, so twist follows the body;
 * clavicles and hips: AB is the spine's up direction;
-* arms and legs: X is the hinge axis of the elbow or knee (upper × lower segment). Both bones of a limb and
-  the hand or foot share it, so the elbow and knee bend about one axis and never twist like a candy wrapper.
+* arms and legs: X is the hinge axis of the elbow or knee (upper × lower segment). The forearm/shin and the
+  hand/foot carry it across by the minimal rotation between neighbouring segments, so the elbow and knee bend
+  about one axis and nothing twists like a candy wrapper.
   A straight limb has no bend plane; the hinge then blends smoothly into an anatomical default (elbows bend
   toward the chest's front, knees about the hips' left-right axis).
 
