@@ -37,7 +37,8 @@ def open_blend(path: str) -> None:
     try:
         bpy.ops.wm.open_mainfile(filepath=os.path.abspath(path), load_ui=False)
     except RuntimeError as exc:
-        raise ValueError(f"{path}: not a readable .blend file ({str(exc).strip().splitlines()[-1]})") from None
+        message = str(exc).strip().removeprefix("Error: ").strip().splitlines()[-1]
+        raise ValueError(f"{path}: not a readable .blend file ({message})") from None
 
 
 def bake_to_file(take: Take, out_path: str, *, rig_path: str | None = None, armature: str | None = None,

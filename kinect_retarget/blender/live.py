@@ -418,17 +418,12 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
     """The `live` command: open the rig (or build the generated one with `rig_lengths`), run the pump loop
     for `seconds` (or until the source ends), bake the recording, save `out`. Returns the statistics."""
     from .. import register, unregister
-    from .headless import find_armature
+    from .headless import find_armature, open_blend
     from .kinect_rig import build_kinect_rig
     from .mapping_ui import fill_table
 
     if rig_path:
-        if not os.path.isfile(rig_path):
-            raise ValueError(f"{rig_path}: rig file not found")
-        try:
-            bpy.ops.wm.open_mainfile(filepath=os.path.abspath(rig_path), load_ui=False)
-        except RuntimeError as exc:  # not a .blend, or a damaged one: Blender says which
-            raise ValueError(f"{rig_path}: cannot open the rig ({_blender_message(exc)})") from None
+        open_blend(rig_path)
         register()
         try:
             obj = find_armature(armature)

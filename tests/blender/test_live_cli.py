@@ -155,7 +155,7 @@ def test_live_usb_without_a_working_device_fails_with_the_reason():
 def test_live_unreadable_rig_or_unwritable_out_is_one_error_line(tmp_path):
     not_blend = tmp_path / "rig.blend"
     not_blend.write_text("this is not a .blend file")
-    for args, expect in ((("--rig", str(not_blend)), "cannot open the rig"),
+    for args, expect in ((("--rig", str(not_blend)), "not a readable .blend file"),
                          (("--out", "/proc/out.blend"), "cannot save")):
         proc = run_cli("--source", f"take:{SAMPLE}", "--seconds", "0.3", *args)
         assert proc.returncode == 2, proc.stderr[-2000:]
