@@ -6,13 +6,8 @@ import contextlib
 import json
 import os
 import sys
-import numpy as np
 
-# Typical adult segment lengths (m) for a generated rig when no take gives real ones (OSC, USB sources).
-TYPICAL_LENGTHS = {"SpineBase": 0.2, "HipCenter": 0.2, "SpineMid": 0.25, "Spine": 0.25, "SpineShoulder": 0.25,
-                   "ShoulderCenter": 0.3, "Neck": 0.1, "Head": 0.15, "Shoulder": 0.18, "Elbow": 0.28,
-                   "Wrist": 0.25, "Hand": 0.08, "HandTip": 0.07, "Thumb": 0.05, "Hip": 0.09, "Knee": 0.42,
-                   "Ankle": 0.4, "Foot": 0.12}
+from .core.kinect_rig_layout import typical_segment_lengths
 
 
 def add_parser(sub) -> None:
@@ -53,14 +48,6 @@ def stdout_to_stderr():
         os.close(saved)
 
 
-def typical_lengths(skeleton) -> np.ndarray:
-    out = []
-    for name in skeleton.joints:
-        key = name[:-4] if name.endswith("Left") else name[:-5] if name.endswith("Right") else name
-        out.append(TYPICAL_LENGTHS.get(key, 0.1))
-    return np.array(out)
-
-
 def run_live(args) -> int:
     from .sources import SourceError, open_source
 
@@ -83,7 +70,7 @@ def run_live(args) -> int:
             from .core.kinect_rig_layout import median_segment_lengths
             lengths = median_segment_lengths(take)
         else:
-            lengths = typical_lengths(source.skeleton)
+            lengths = typical_segment_lengths(source.skeleton)
     with stdout_to_stderr():
         from .blender.live import run_headless
         result = run_headless(source, args.seconds, rig_path=args.rig, armature=args.armature,

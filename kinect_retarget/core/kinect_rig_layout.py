@@ -25,6 +25,11 @@ _DIRECTIONS = {
     "Hip": normalize(np.array([1.0, 0.0, -0.8])), "Knee": DOWN, "Ankle": DOWN, "Foot": FORWARD,
 }
 DEFAULT_LENGTH = 0.1
+# Typical adult segment lengths (m), for a generated rig when no take gives real ones (OSC, USB sources).
+TYPICAL_LENGTHS = {"SpineBase": 0.2, "HipCenter": 0.2, "SpineMid": 0.25, "Spine": 0.25, "SpineShoulder": 0.25,
+                   "ShoulderCenter": 0.3, "Neck": 0.1, "Head": 0.15, "Shoulder": 0.18, "Elbow": 0.28,
+                   "Wrist": 0.25, "Hand": 0.08, "HandTip": 0.07, "Thumb": 0.05, "Hip": 0.09, "Knee": 0.42,
+                   "Ankle": 0.4, "Foot": 0.12}
 
 
 def rest_direction(joint: str) -> np.ndarray:
@@ -34,6 +39,15 @@ def rest_direction(joint: str) -> np.ndarray:
             d[0] *= sign
             return d
     return _DIRECTIONS[joint]
+
+
+def typical_segment_lengths(skeleton: Skeleton) -> np.ndarray:
+    """(J,) typical adult length of the segment ending at each joint (the root's: the hip width)."""
+    out = []
+    for name in skeleton.joints:
+        key = name.removesuffix("Left").removesuffix("Right")
+        out.append(TYPICAL_LENGTHS.get(key, DEFAULT_LENGTH))
+    return np.array(out)
 
 
 def median_segment_lengths(take: Take) -> np.ndarray:

@@ -13,13 +13,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED
+from ..core.skeletons import KINECT_V1
 from ..core.take import Take
 from .body_model_fit import BodyCalibration
 from .camera import DepthCamera
 from .confidence import ConfidenceCheck
 from .segmentation import DepthGrid, FloorPlane, PersonMask, find_people, fit_floor
-from .skeleton_fit import J, FitResult, fit_person
+from .skeleton_fit import FitResult, fit_person
 
 LOST_RESET_S = 0.5   # forget the previous pose after this long without the person (then re-acquire)
 CALIBRATION_FRAMES = 15

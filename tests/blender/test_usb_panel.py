@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import kinect_retarget
-from kinect_retarget.cli_live import typical_lengths
+from kinect_retarget.core.kinect_rig_layout import typical_segment_lengths
 from kinect_retarget.blender import live, usb_panel
 from kinect_retarget.blender.kinect_rig import build_kinect_rig
 from kinect_retarget.core.skeletons import KINECT_V1
@@ -187,7 +187,7 @@ def test_live_on_the_simulated_kinect_previews_person_and_skeleton(registered, m
     scene = registered
     _simulate(scene)
     bpy.ops.kinect_retarget.usb_preview()              # a preview stream runs: live must take the device over
-    obj = build_kinect_rig(scene, KINECT_V1, typical_lengths(KINECT_V1), "KinectRig")
+    obj = build_kinect_rig(scene, KINECT_V1, typical_segment_lengths(KINECT_V1), "KinectRig")
     bpy.context.view_layer.objects.active = obj
     s = scene.kinect_retarget
     s.initialised, s.armature, s.preset, s.play_on_record = True, obj, "kinect", False
@@ -218,7 +218,7 @@ def test_live_while_the_simulated_kinect_is_prepared_says_so(registered, monkeyp
     monkeypatch.setattr(usb_panel, "simulated_images", slow_images)
     scene = registered
     scene.kinect_retarget_usb.simulate = True
-    obj = build_kinect_rig(scene, KINECT_V1, typical_lengths(KINECT_V1), "KinectRig")
+    obj = build_kinect_rig(scene, KINECT_V1, typical_segment_lengths(KINECT_V1), "KinectRig")
     bpy.context.view_layer.objects.active = obj
     scene.kinect_retarget.initialised = True
     try:

@@ -1,11 +1,9 @@
-import os
 import time
 
 import numpy as np
 import pytest
 
 from kinect_retarget.core.skeletons import KINECT_V2, NOT_TRACKED
-from kinect_retarget.core.take import Take
 from kinect_retarget.live.frames import SkeletonFrame
 from kinect_retarget.live.queueing import FrameQueue
 from kinect_retarget.live.session import LiveSession
