@@ -35,6 +35,15 @@ def numeric_first_row(head: bytes, ncol: int, delimiters: bytes = b"") -> list[b
     return fields
 
 
+def check_rising(path: str, lines: np.ndarray, stamps: np.ndarray, show=lambda t: f"{t:g}") -> None:
+    """TakeError naming the first line whose timestamp does not come after the previous line's."""
+    step = np.diff(stamps)
+    if np.any(step <= 0):
+        i = int(np.argmax(step <= 0)) + 1
+        raise TakeError(f"{path}:{int(lines[i])}: timestamp {show(stamps[i])} is not after the previous "
+                        f"line's {show(stamps[i - 1])}")
+
+
 def field_counts(data: bytes) -> np.ndarray:
     """Number of whitespace-separated fields on each line of `data` (lines split at b'\\n')."""
     buf = np.frombuffer(data, dtype=np.uint8)

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..core.skeletons import KINECT_V2, NOT_TRACKED
 from ..core.take import Take, TakeError, nominal_rate
-from ._numeric import parse_table, read_bytes
+from ._numeric import check_rising, parse_table, read_bytes
 
 TICKS_PER_SECOND = 10_000_000
 NCOL = 1 + 4 * len(KINECT_V2)
@@ -45,11 +45,7 @@ def make_take(path: str, values: np.ndarray, lines: np.ndarray, source_format: s
         i = int(np.argmax(bad.any(axis=1)))
         raise TakeError(f"{path}:{int(lines[i])}: tracking state must be 0, 1 or 2")
     ticks = values[:, 0]
-    step = np.diff(ticks)
-    if np.any(step <= 0):
-        i = int(np.argmax(step <= 0)) + 1
-        raise TakeError(f"{path}:{int(lines[i])}: timestamp {ticks[i]:.0f} is not after the previous "
-                        f"line's {ticks[i - 1]:.0f}")
+    check_rising(path, lines, ticks, show=lambda t: f"{t:.0f}")
     states = states.astype(np.uint8)
     if not np.any(states != NOT_TRACKED):
         raise TakeError(f"{path}: no joint is tracked in any frame")

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..core.skeletons import KINECT_V1, NOT_TRACKED, TRACKED
 from ..core.take import Take, TakeError, nominal_rate
-from ._numeric import numeric_first_row, parse_table, read_bytes
+from ._numeric import check_rising, numeric_first_row, parse_table, read_bytes
 
 NCOL = 1 + 4 * len(KINECT_V1)
 
@@ -29,11 +29,7 @@ def read(path: str | os.PathLike) -> Take:
     if not np.any(states != NOT_TRACKED):
         raise TakeError(f"{path}: no joint is tracked in any frame (all rows are zeros)")
     times = values[:, 0]
-    step = np.diff(times)
-    if np.any(step <= 0):
-        i = int(np.argmax(step <= 0)) + 1
-        raise TakeError(f"{path}:{int(lines[i])}: timestamp {times[i]:g} s is not after the previous "
-                        f"line's {times[i - 1]:g} s")
+    check_rising(path, lines, times, show=lambda t: f"{t:g} s")
     positions = np.where(states[..., None] == TRACKED, block[..., :3], np.nan)
     rel = times - times[0]
     meta = {"source_file": os.path.basename(path), "first_timestamp_s": float(times[0])}
