@@ -27,6 +27,7 @@ from ..takes import load_take
 from .bake_take import bake_take
 from .mapping_ui import table_overrides
 from .pose_apply import apply_frame_pose, restore_pose, snapshot_pose
+from .evaluated_solve import correct_for_evaluation
 from .preferences import get_preferences
 from .properties import ensure_defaults, target_armature
 from .rig_reader import target_rig_from_object
@@ -58,6 +59,7 @@ class LiveController:
                 if hasattr(pipeline, "rig") else None
             self.corrector = corrector if corrector is not None and corrector.active else None
             self.update_after_apply = bool(bpy.app.background)
+            self.exact = bool(getattr(scene.kinect_retarget, "exact_constrained", False))
             if self.corrector is not None:
                 self._read = [(b, pipeline.rig.bone_names[b]) for b in self.corrector.read]
         except Exception:
@@ -91,7 +93,11 @@ class LiveController:
         if obj is None:
             raise RuntimeError(f"armature {self.obj_name!r} no longer exists")
         if self.corrector is not None:
-            pose.quats = self.corrector.correct(pose.quats, self._evaluated(obj), getattr(pose, "desired", None))
+            desired = getattr(pose, "desired", None)
+            pose.quats = self.corrector.correct(pose.quats, self._evaluated(obj), desired)
+            if self.exact and desired is not None:  # the bake's own correction, from this close start
+                pose.quats = correct_for_evaluation(obj, pose.bone_names, pose.quats[None], pose.root_bone,
+                                                    pose.root_location[None], desired[None])[0]
         apply_frame_pose(obj, pose)
         if self.corrector is not None and self.update_after_apply:
             bpy.context.view_layer.update()  # no viewport redraw to evaluate the constrained parents

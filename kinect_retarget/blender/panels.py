@@ -141,6 +141,7 @@ class KINECT_RETARGET_PT_options(_KinectPanel, bpy.types.Panel):
         col.prop(s, "filter")
         col.prop(s, "root")
         col.prop(s, "mirror")
+        col.prop(s, "exact_constrained")
         col = layout.column(heading="Recording")
         col.prop(s, "record_dir")
         col.prop(s, "play_on_record")

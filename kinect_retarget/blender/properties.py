@@ -45,6 +45,11 @@ class KinectRetargetSettings(bpy.types.PropertyGroup):
     filter: EnumProperty(name="Filter", items=FILTER_ITEMS, default="default")
     root: EnumProperty(name="Root Motion", items=ROOT_ITEMS, default="xyz")
     mirror: BoolProperty(name="Mirror", default=False, description="Swap the performer's left and right")
+    exact_constrained: BoolProperty(
+        name="Exact on Constrained Rigs", default=False,
+        description="On rigs whose bones hang from constraint-driven parents (Rigify), correct every live pose "
+                    "through Blender's evaluation as the bake does, so live equals the baked pose; costs a few "
+                    "Blender evaluations per frame")
     record_dir: StringProperty(name="Folder", subtype="DIR_PATH", default="//kinect_takes/")
     play_on_record: BoolProperty(name="Play Timeline", default=True,
                                  description="Start timeline playback when recording starts (keeps audio in sync)")
