@@ -222,8 +222,18 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
             if e is not None and root == "Shoulder" and (1.0 if s == "Left" else -1.0) * e[4] < -0.1 * H \
                     and not (prev is not None and np.linalg.norm(e[1] - prev[J[f"{tip}{s}"]]) < 0.15):
                 e = None  # out beyond the other shoulder and not followed there: the other side's part
-            a = pos[J[f"{root}{s}"]]
-            l1, l2 = r1 * H, r2 * H
+
+            def without_extremity():
+                """(end, tip, mid level-set) when no extremity stands for this limb: a hanging arm found in
+                the depth, else the previous frame's limb carried along."""
+                found_arm = _hanging_arm(xyz, mask, a, axis, lat, 1.0 if s == "Left" else -1.0, centre, H) \
+                    if root == "Shoulder" else None
+                if found_arm is None:
+                    return _carry(prev, s, end, tip, a, axis, pos, root)
+                toward = _unit(a - found_arm)
+                tip_p = found_arm + toward * 0.07 + inside(tip)
+                return tip_p + toward * bm.HAND * H, tip_p, None
+
             if e is not None:
                 de = graph.distances(np.array([e[0]]), iterations=4)
                 tip_p = level_set_centroid(xyz, de, d_tip, band(0.05), e[1], 0.2)
@@ -239,24 +249,9 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
                 st_limb = TRACKED if along_limb > 0.7 * (l1 + l2) else INFERRED
                 if st_limb == INFERRED and root == "Shoulder":
                     # not a hand (an elbow, a shoulder): look for the arm as if no extremity was found
-                    found_arm = _hanging_arm(xyz, mask, a, axis, lat, 1.0 if s == "Left" else -1.0, centre, H)
-                    if found_arm is not None:
-                        toward = _unit(a - found_arm)
-                        tip_p = found_arm + toward * 0.07 + inside(tip)
-                        end_p = tip_p + toward * bm.HAND * H
-                        mid_ls = None
-                    else:
-                        end_p, tip_p, mid_ls = _carry(prev, s, end, tip, a, axis, pos, root)
+                    end_p, tip_p, mid_ls = without_extremity()
             else:
-                found_arm = _hanging_arm(xyz, mask, a, axis, lat, 1.0 if s == "Left" else -1.0, centre, H) \
-                    if root == "Shoulder" else None
-                if found_arm is not None:
-                    toward = _unit(a - found_arm)
-                    tip_p = found_arm + toward * 0.07 + inside(tip)
-                    end_p = tip_p + toward * bm.HAND * H
-                    mid_ls = None
-                else:
-                    end_p, tip_p, mid_ls = _carry(prev, s, end, tip, a, axis, pos, root)
+                end_p, tip_p, mid_ls = without_extremity()
                 st_limb = INFERRED
             cands, end_p2 = two_bone_candidates(a, end_p, l1, l2)
             cost = proj.cost(cands, bm.DEPTH_INSIDE[mid])
