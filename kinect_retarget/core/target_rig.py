@@ -77,7 +77,7 @@ def evaluate_pose(rig: TargetRig, bone_indices: np.ndarray, quats: np.ndarray,
     if root_bone is not None and root_location is not None:
         basis[:, root_bone, :3, 3] = root_location
     posed = np.empty((f, nb, 4, 4))
-    for b in _topological(rig):
+    for b in parents_first_order(rig):
         p = rig.parents[b]
         if p < 0:
             posed[:, b] = rig.rest[b] @ basis[:, b]
@@ -92,7 +92,8 @@ def evaluate_pose(rig: TargetRig, bone_indices: np.ndarray, quats: np.ndarray,
     return posed
 
 
-def _topological(rig: TargetRig) -> list[int]:
+def parents_first_order(rig: TargetRig) -> list[int]:
+    """Bone indices with every parent before its children."""
     order, seen = [], set()
 
     def visit(b: int) -> None:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.quat import from_matrix, to_matrix
-from ..core.target_rig import TargetRig, _topological
+from ..core.target_rig import TargetRig, parents_first_order
 
 
 class ConstrainedParentCorrection:
@@ -20,7 +20,7 @@ class ConstrainedParentCorrection:
         needed = set(self.mapped)
         for b in self.mapped:
             needed.update(rig.ancestors(b))
-        self.order = [b for b in _topological(rig) if b in needed]
+        self.order = [b for b in parents_first_order(rig) if b in needed]
         self.constrained = {rig.index(n) for n in constrained_bones if rig.has(n)} & needed
         rot = rig.rest[:, :3, :3]
         self.rel = {b: (rot[b] if rig.parents[b] < 0 else rot[rig.parents[b]].T @ rot[b]) for b in self.order}
