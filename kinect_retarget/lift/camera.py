@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.conventions import kinect_to_depth_pixel
+from ..core.conventions import depth_pixel_to_kinect, kinect_to_depth_pixel
 
 DEFAULT_FOV_FACTOR = 1.0
 
@@ -35,8 +35,7 @@ class Camera:
     def rays(self, uv: np.ndarray) -> np.ndarray:
         """(..., 2) pixels -> (..., 3) rays with Z = 1 (a point at depth Z is Z * ray)."""
         uv = np.asarray(uv, dtype=np.float64)
-        return np.stack([-(uv[..., 0] - self.cx) / self.focal_px, -(uv[..., 1] - self.cy) / self.focal_px,
-                         np.ones(uv.shape[:-1])], axis=-1)
+        return depth_pixel_to_kinect(uv[..., 0], uv[..., 1], np.ones(uv.shape[:-1]), self.focal_px, self.cx, self.cy)
 
 
 def look_at_rotation(azimuth_deg: float, elevation_deg: float = 0.0) -> np.ndarray:
