@@ -87,14 +87,15 @@ class RetargetPipeline:
         self.root_reference: np.ndarray | None = None
         self._last_seen = np.full((len(self.skeleton), 3), np.nan)  # last finite position of each joint
 
-    def _fill_missing(self, positions: np.ndarray, backfill: bool) -> np.ndarray:
+    def _fill_missing(self, positions: np.ndarray, backfill: bool) -> tuple[np.ndarray, np.ndarray]:
         """Readers mark joints they have no position for with NaN (untracked): carry each joint's last known
         position forward (and, for a whole take, its first one backward), so nothing NaN reaches the solver.
-        Joints never seen stay NaN; their bones are not driven (see _unseen_bones)."""
+        Returns the positions and (M,) True for mapped bones on a joint still unknown at the last frame: such
+        joints stand at the root (NaN while the root itself is unknown) and their bones are not driven."""
         finite = np.all(np.isfinite(positions), axis=-1)
         if finite.all():
             self._last_seen = positions[-1].copy()
-            return positions
+            return positions, np.zeros(len(self.retargeter.mapped), dtype=bool)
         nf, nj = finite.shape
         src = np.maximum.accumulate(np.where(finite, np.arange(nf)[:, None], -1), axis=0)
         out = positions[np.maximum(src, 0), np.arange(nj)]
@@ -105,12 +106,10 @@ class RetargetPipeline:
             lead = before & finite.any(axis=0)
             out[lead] = positions[first, np.arange(nj)][np.nonzero(lead)[1]]
         self._last_seen = np.where(np.isfinite(out[-1]), out[-1], self._last_seen)
-        return out
-
-    def _unseen_bones(self, positions: np.ndarray) -> np.ndarray:
-        """(M,) True for mapped bones whose segment has a joint with no position at all."""
-        unseen = ~np.all(np.isfinite(positions), axis=(0, 2))
-        return np.array([unseen[m.head] or unseen[m.tail] for m in self.retargeter.mapped])
+        unknown = ~np.all(np.isfinite(out[-1]), axis=-1)
+        unseen = np.array([unknown[m.head] or unknown[m.tail] for m in self.retargeter.mapped])
+        root = self.skeleton.root
+        return np.where(np.isfinite(out), out, out[:, root:root + 1]), unseen
 
     def calibrate(self, positions: np.ndarray) -> float | None:
         """Fix the source leg length (root scale n) from (F, J, 3) frames of the performer standing."""
@@ -137,12 +136,10 @@ class RetargetPipeline:
         keyed = np.flatnonzero(take.any_tracked)
         if keyed.size == 0:
             raise TakeError("take has no frame with a tracked joint: nothing to bake")
-        positions = self._fill_missing(take.positions[keyed], backfill=True)
-        unseen = self._unseen_bones(positions)
+        positions, unseen = self._fill_missing(take.positions[keyed], backfill=True)
         if self.retargeter.root is not None and unseen[self.retargeter.mapped.index(self.retargeter.root)]:
             raise TakeError(f"take never gives a position for the root joint "
                             f"{self.skeleton.joints[self.skeleton.root]}: nothing to bake")
-        positions = np.where(np.isfinite(positions), positions, positions[:, self.skeleton.root:self.skeleton.root + 1])
         positions = self._filtered(positions, take.states[keyed], take.times[keyed])
         if self.source_leg is None:
             self.source_leg = leg_length(resolver(self.skeleton.joints, positions))
@@ -152,10 +149,11 @@ class RetargetPipeline:
         quats, location, desired = self.retargeter.solve(positions[first], self.root_reference, self.source_leg,
                                                          want_desired=True)
         keep = ~unseen  # bones on joints the take never saw are left alone, not keyed
-        return BakedMotion(frames[first], tuple(np.array(self.bone_names)[keep]), make_continuous(quats[:, keep], axis=0),
+        names = np.array(self.bone_names)
+        return BakedMotion(frames[first], tuple(names[keep]), make_continuous(quats[:, keep], axis=0),
                            self.root_bone, location, fps, keyed[first],
                            {"desired": desired[:, keep], "positions": positions[first],
-                            "skipped_bones": tuple(np.array(self.bone_names)[unseen])})
+                            "skipped_bones": tuple(names[unseen])})
 
     def process_frame(self, positions: np.ndarray, states: np.ndarray, time: float) -> FramePose | None:
         """One live frame; None when no joint is tracked (nothing to apply, filter untouched)."""
@@ -172,12 +170,10 @@ class RetargetPipeline:
         positions, states, times = positions[keep], states[keep], times[keep]
         if not np.all(np.isfinite(positions[states != NOT_TRACKED])):
             raise ValueError("frame has NaN or infinite positions for tracked joints")
-        positions = self._fill_missing(positions, backfill=False)
+        positions, unseen = self._fill_missing(positions, backfill=False)
         root = self.skeleton.root
         if not np.all(np.isfinite(positions[:, root])):
             return None  # nothing known about the root yet
-        unseen = self._unseen_bones(positions[-1:])
-        positions = np.where(np.isfinite(positions), positions, positions[:, root:root + 1])
         p = self._filtered(positions, states, times)
         if self.root_reference is None:
             self.root_reference = p[0, root].copy()
