@@ -15,6 +15,7 @@ import numpy as np
 
 from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED
 from . import body_model_fit as bm
+from .arm_search import ArmScorer, TorsoFrame, arm_evidence, search_arm
 from .geodesic import SurfaceGraph, geodesic_extrema, geodesic_maxima, level_set_centroid
 
 J = {n: i for i, n in enumerate(KINECT_V1.joints)}
@@ -26,6 +27,8 @@ SIDES = ("Left", "Right")
 AXIS_GRAVITY_WEIGHT = 0.75  # torso axis = this blend of gravity's up and the torso patch's long axis
 SIDE_ON_WIDTH = 0.165       # visible chest width / height below which the torso is taken as seen side-on
 MID_NEEDS_SUPPORT = True    # an elbow/knee is tracked only where the depth image backs it (projective check)
+CONTINUITY_RADIUS = 0.25    # m a lone hand/foot may move from a tracked one and still be taken for it
+ARM_SEARCH = True           # arms without a hand extremity: search poses against the depth (arm_search)
 REACH_SLACK = 0.10          # m an extremity may lie beyond the limb's calibrated reach and still be its end
 
 
@@ -274,6 +277,8 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
             mid_ok = st_limb == TRACKED and proj.supported(m, bm.DEPTH_INSIDE[mid] - 0.02)
             st[J[f"{mid}{s}"]] = TRACKED if mid_ok or (st_limb == TRACKED and not MID_NEEDS_SUPPORT) else INFERRED
             st[J[f"{end}{s}"]] = st[J[f"{tip}{s}"]] = st_limb
+    if ARM_SEARCH:
+        _search_unseen_arms(pos, st, xyz, mask, proj, TorsoFrame(centre, axis, lat, facing, pos, H), H, prev)
     # without the head top or the shoulders the torso's place along its axis is a guess; seen more than
     # 45 degrees from the front, shoulders and hips overlap in depth: say so instead of claiming them
     if shift is None:
@@ -282,6 +287,21 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
         for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
             st[J[name]] = INFERRED
     return FitResult(pos, st, lat, labels, centre, None if head is None else head[1], proj, edge_on or narrow)
+
+
+def _search_unseen_arms(pos, st, xyz, mask, proj, frame, H, prev) -> None:
+    """Arms whose hand is not a tracked extremity: the pose that best explains the depth (arm_search)."""
+    scorer = None
+    for s in SIDES:
+        if st[J[f"Hand{s}"]] == TRACKED:
+            continue
+        if scorer is None:
+            scorer = ArmScorer(proj, arm_evidence(xyz, mask, pos, frame), frame)
+        pe, ph = (None, None) if prev is None else (prev[J[f"Elbow{s}"]], prev[J[f"Hand{s}"]])
+        e, w, h, _ = search_arm(scorer, pos[J[f"Shoulder{s}"]], bm.UPPER_ARM * H, bm.FOREARM * H, bm.HAND * H, H,
+                                pe, ph)
+        pos[J[f"Elbow{s}"]], pos[J[f"Wrist{s}"]], pos[J[f"Hand{s}"]] = e, w, h
+        st[[J[f"Elbow{s}"], J[f"Wrist{s}"], J[f"Hand{s}"]]] = INFERRED
 
 
 def _visible_chest_width(pts, centre, axis, view, H):
@@ -348,8 +368,10 @@ def _assign_sides(found, prev, prev_states, tip, lat, centre) -> dict:
     if tip == "Foot" and len(found) == 2 and found[0][4] * found[1][4] < 0 \
             and abs(found[0][4] - found[1][4]) > 0.25:
         return dict(zip(SIDES, found if found[0][4] > 0 else found[::-1]))
-    have_prev = prev is not None and prev_states is not None and all(
-        prev_states[J[f"{tip}{s}"]] != NOT_TRACKED for s in SIDES)
+    # only a previous position that rested on evidence says where a side's hand/foot is now
+    seen = {s: prev is not None and prev_states is not None and prev_states[J[f"{tip}{s}"]] == TRACKED
+            for s in SIDES}
+    have_prev = all(seen.values())
     if len(found) == 2:
         if have_prev:
             a = sum(np.linalg.norm(f[1] - prev[J[f"{tip}{s}"]]) for f, s in zip(found, SIDES))
@@ -361,8 +383,7 @@ def _assign_sides(found, prev, prev_states, tip, lat, centre) -> dict:
             return dict(zip(SIDES, found if a <= b else found[::-1]))
         return dict(zip(SIDES, found if found[0][4] >= found[1][4] else found[::-1]))
     f = found[0]
-    if have_prev:
-        dl = np.linalg.norm(f[1] - prev[J[f"{tip}Left"]])
-        dr = np.linalg.norm(f[1] - prev[J[f"{tip}Right"]])
-        return {"Left" if dl <= dr else "Right": f}
+    near = {s: np.linalg.norm(f[1] - prev[J[f"{tip}{s}"]]) for s in SIDES if seen[s]}
+    if near and min(near.values()) < CONTINUITY_RADIUS:
+        return {min(near, key=near.get): f}
     return {"Left" if f[4] >= 0 else "Right": f}

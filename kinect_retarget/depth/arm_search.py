@@ -1,0 +1,179 @@
+"""Arms without a hand extremity (hanging against the body, a hand on the face, folded over the chest),
+found by searching arm poses against the depth image (analysis by synthesis).
+
+A candidate is the chain shoulder -> elbow -> wrist -> hand with the calibrated bone lengths. Points along
+its bones are projected into the person's depth grid, and each scores
+- agreement: the observed surface should lie at the bone's front (its depth minus its radius), or in front
+  of it (occluded: a small cost); a surface seen well behind it means the arm would have hidden it (free
+  space violated: full cost), and so does a point off the person's silhouette;
+- explanation: the person's cells that neither the torso, the head nor the legs account for ("arm
+  evidence") reward a bone that covers them at the right depth, so an arm is not laid over the chest where
+  any pose agrees with the surface.
+Upper-arm directions on a sphere are scored first, the best few extended by forearm directions, and the
+best chain is refined in a finer cone. Pure numpy; a few thousand point lookups per arm.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.skeletons import KINECT_V1
+
+J = {n: i for i, n in enumerate(KINECT_V1.joints)}
+
+
+def _sphere(n: int) -> np.ndarray:
+    """n nearly uniform unit directions (Fibonacci lattice)."""
+    i = np.arange(n) + 0.5
+    phi = np.arccos(1 - 2 * i / n)
+    theta = np.pi * (1 + 5 ** 0.5) * i
+    return np.stack([np.cos(theta) * np.sin(phi), np.sin(theta) * np.sin(phi), np.cos(phi)], axis=1)
+
+
+DIRECTIONS = _sphere(160)          # about 16 degrees apart
+REFINE = _sphere(24) * 0.14        # offsets of a refinement cone, about 8 degrees
+UPPER_KEEP = 8                     # upper-arm directions carried into the forearm search
+FOLD_LIMIT = -0.85                 # cos of the tightest elbow fold allowed between upper arm and forearm
+# sample points along each bone (fraction of its length) and the bone's radius (fraction of height)
+UPPER_T, UPPER_R = np.array([0.4, 0.6, 0.8, 1.0]), 0.026
+FORE_T, FORE_R = np.array([0.2, 0.4, 0.6, 0.8, 1.0]), 0.02
+HAND_T, HAND_R = np.array([0.5, 1.0]), 0.015
+FREE_SPACE = 0.08      # m: a surface seen this far behind a bone's front is where the bone cannot be
+OCCLUDED = 0.06        # m: a surface this far in front of it hides it
+OCCLUSION_COST = 0.35  # hidden is possible but explains nothing
+COVER_TOL = 0.08       # m: depth agreement for a covered evidence cell
+W_COVER = 0.8          # reward per sample on arm evidence, against a cost of 1 for a free-space violation
+ON_BODY_COST = 0.2     # a bone on the torso's own surface: an arm lying there would stand out in front of it
+W_PREVIOUS = 0.5       # per metre from the previous frame's elbow and hand
+INSIDE_COST = 2.0      # an elbow or hand inside the torso
+TORSO_HALF_WIDTH = 0.1   # fraction of height: the trunk's half width seen from the front
+IN_FRONT = 0.06        # m in front of the chest's surface: an arm, not the chest
+TORSO_BAND = 0.04      # fraction of height: bands of the trunk whose surface depth is taken apart
+HEAD_HALF_WIDTH = 0.065  # fraction of height: head and neck, above the shoulder line
+LEG_RADIUS = 0.09      # m around the fitted leg bones
+
+
+def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    ab = b - a
+    t = np.clip(((p - a) @ ab) / max(ab @ ab, 1e-12), 0.0, 1.0)
+    return np.linalg.norm(p - (a + t[..., None] * ab), axis=-1)
+
+
+class TorsoFrame:
+    """The fitted torso's place: centre on the chest's surface, unit axis (up), lat (performer's left),
+    facing (toward the sensor), and the heights along the axis of the hips and shoulders."""
+
+    def __init__(self, centre, axis, lat, facing, pos, H):
+        self.centre, self.axis, self.lat, self.facing, self.H = centre, axis, lat, facing, H
+        self.hip_a = (pos[J["HipCenter"]] - centre) @ axis
+        self.shoulder_a = (pos[J["ShoulderCenter"]] - centre) @ axis
+
+    def coords(self, pts):
+        rel = pts - self.centre
+        return rel @ self.axis, rel @ self.lat, rel @ self.facing
+
+    def torso(self, pts, mask, half_width=TORSO_HALF_WIDTH, front=IN_FRONT):
+        """Cells of the trunk: within its width between hips and shoulders, and not standing out in front of
+        its surface. The surface's depth is the median of each height band, so a forward lean or a bent
+        back does not make the upper chest look like an arm in front of it."""
+        a, l, f = self.coords(pts)
+        box = mask & (a > self.hip_a - 0.03 * self.H) & (a < self.shoulder_a + 0.03 * self.H) \
+            & (np.abs(l) < half_width * self.H)
+        band = np.floor((a - self.hip_a) / (TORSO_BAND * self.H)).astype(np.int64)
+        surface = np.zeros_like(f)
+        for b in np.unique(band[box]):
+            sel = box & (band == b)
+            surface[sel] = np.median(f[sel])
+        return box & (f < surface + front)
+
+    def inside(self, pts):
+        """Points well inside the trunk (behind its front surface, within its width)."""
+        a, l, f = self.coords(pts)
+        return (a > self.hip_a) & (a < self.shoulder_a) & (np.abs(l) < 0.08 * self.H) & (f < -0.03) & (f > -0.25)
+
+
+def arm_evidence(xyz: np.ndarray, mask: np.ndarray, pos: np.ndarray, frame: TorsoFrame) -> np.ndarray:
+    """Cells of the person that the torso, head and fitted legs leave unexplained."""
+    ev = mask & ~frame.torso(xyz, mask)
+    a, l, f = frame.coords(xyz)
+    face = (pos[J["Head"]] - frame.centre) @ frame.facing + 0.10   # the head joint sits 10 cm behind the face
+    ev &= ~((a > frame.shoulder_a - 0.03 * frame.H) & (np.abs(l) < HEAD_HALF_WIDTH * frame.H) & (f < face + IN_FRONT))
+    for s in ("Left", "Right"):
+        for a, b in (("Hip", "Knee"), ("Knee", "Ankle"), ("Ankle", "Foot")):
+            ev &= _segment_distance(xyz, pos[J[f"{a}{s}"]], pos[J[f"{b}{s}"]]) > LEG_RADIUS
+    return ev
+
+
+class ArmScorer:
+    """Per-sample cost of arm bones against one frame's cropped depth grid."""
+
+    def __init__(self, projector, evidence: np.ndarray, frame: TorsoFrame):
+        self.p, self.evidence, self.frame = projector, evidence, frame
+
+    def samples(self, pts: np.ndarray, radius: float):
+        """(cost, covered) per sample point: the agreement cost, and the evidence cell it covers (-1: none)."""
+        p = self.p
+        shape = pts.shape[:-1]
+        flat = pts.reshape(-1, 3)
+        rc = np.round((p.grid.to_pixel(flat) - [p.r0, p.c0]) / p.k).astype(np.int64)
+        h, w = p.mask.shape
+        ok = (rc[:, 0] >= 0) & (rc[:, 0] < h) & (rc[:, 1] >= 0) & (rc[:, 1] < w)
+        r, c = np.clip(rc[:, 0], 0, h - 1), np.clip(rc[:, 1], 0, w - 1)
+        on = ok & p.mask[r, c]
+        dz = p.xyz[r, c, 2] - (flat[:, 2] - radius)   # > 0: the surface is seen behind the bone's front
+        cover = on & self.evidence[r, c] & (np.abs(dz) <= COVER_TOL)
+        cost = np.where(~on | (dz > FREE_SPACE), 1.0,
+                        np.where(dz < -OCCLUDED, OCCLUSION_COST, np.where(cover, 0.0, ON_BODY_COST)))
+        return cost.reshape(shape), np.where(cover, r * w + c, -1).reshape(shape)
+
+    def score(self, bones) -> np.ndarray:
+        """Cost of chains given as [(points (..., n, 3), radius)]: agreement summed over the samples, minus a
+        reward per distinct evidence cell covered (two bones over one cell explain it once)."""
+        costs, cells = zip(*(self.samples(pts, radius) for pts, radius in bones))
+        cells = np.sort(np.concatenate(cells, axis=-1), axis=-1)
+        distinct = (cells[..., :1] >= 0).astype(np.int64)[..., 0] + np.sum((np.diff(cells, axis=-1) != 0)
+                                                                          & (cells[..., 1:] >= 0), axis=-1)
+        return sum(c.sum(-1) for c in costs) - W_COVER * distinct
+
+
+def _chain_cost(scorer, shoulder, u, v, l1, l2, lh, H):
+    """Cost of chains (broadcast over u, v): bone samples, plus elbow/hand inside the trunk."""
+    elbow = shoulder + l1 * u
+    wrist = elbow + l2 * v
+    cost = scorer.score([(shoulder[None] + (l1 * u)[..., None, :] * UPPER_T[:, None], UPPER_R * H),
+                         (elbow[..., None, :] + (l2 * v)[..., None, :] * FORE_T[:, None], FORE_R * H),
+                         (wrist[..., None, :] + (lh * v)[..., None, :] * HAND_T[:, None], HAND_R * H)])
+    cost = cost + INSIDE_COST * (scorer.frame.inside(elbow) | scorer.frame.inside(wrist + lh * v))
+    return cost, elbow, wrist, wrist + lh * v
+
+
+def search_arm(scorer: ArmScorer, shoulder, l1, l2, lh, H, prev_elbow=None, prev_hand=None):
+    """Best arm chain -> (elbow, wrist, hand, cost per sample)."""
+    n_samples = len(UPPER_T) + len(FORE_T) + len(HAND_T)
+
+    def prior(elbow, hand):
+        if prev_elbow is None or prev_hand is None:
+            return 0.0
+        return W_PREVIOUS * n_samples * (np.linalg.norm(elbow - prev_elbow, axis=-1)
+                                          + np.linalg.norm(hand - prev_hand, axis=-1))
+
+    up = scorer.score([(shoulder + (l1 * DIRECTIONS)[:, None, :] * UPPER_T[:, None], UPPER_R * H)])
+    up = up + INSIDE_COST * scorer.frame.inside(shoulder + l1 * DIRECTIONS)
+    if prev_elbow is not None:
+        up = up + W_PREVIOUS * n_samples * np.linalg.norm(shoulder + l1 * DIRECTIONS - prev_elbow, axis=-1)
+    u = DIRECTIONS[np.argsort(up)[:UPPER_KEEP]]                       # (K, 3)
+    v = np.broadcast_to(DIRECTIONS, (len(u),) + DIRECTIONS.shape)      # (K, N, 3)
+    uu = np.broadcast_to(u[:, None, :], v.shape)
+    cost, elbow, _, hand = _chain_cost(scorer, shoulder, uu, v, l1, l2, lh, H)
+    cost = cost + prior(elbow, hand) + np.where(np.sum(uu * v, -1) < FOLD_LIMIT, 10.0, 0.0)
+    k, n = np.unravel_index(int(np.argmin(cost)), cost.shape)
+    u0, v0 = u[k], DIRECTIONS[n]
+    # refine: every pair of small offsets of both directions
+    ru = u0 + np.vstack([np.zeros(3), REFINE])
+    rv = v0 + np.vstack([np.zeros(3), REFINE])
+    ru /= np.linalg.norm(ru, axis=1, keepdims=True)
+    rv /= np.linalg.norm(rv, axis=1, keepdims=True)
+    uu, vv = np.broadcast_arrays(ru[:, None, :], rv[None, :, :])
+    cost, elbow, wrist, hand = _chain_cost(scorer, shoulder, uu, vv, l1, l2, lh, H)
+    cost = cost + prior(elbow, hand) + np.where(np.sum(uu * vv, -1) < FOLD_LIMIT, 10.0, 0.0)
+    i, j = np.unravel_index(int(np.argmin(cost)), cost.shape)
+    return elbow[i, j], wrist[i, j], hand[i, j], float(cost[i, j]) / n_samples

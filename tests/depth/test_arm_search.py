@@ -1,0 +1,78 @@
+"""Arms with no hand extremity, found by searching poses against the depth (depth/arm_search.py).
+
+Real motion: CMU 131_02 at the moment the performer holds the right hand to the face while walking. The hand
+touches the head, so it ends no geodesic branch; only the forearm standing out in front of the chest and the
+elbow beside the body say where it is.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from kinect_retarget.core.skeletons import KINECT_V1, TRACKED
+from kinect_retarget.depth import skeleton_fit
+from kinect_retarget.depth.arm_search import DIRECTIONS, search_arm
+from kinect_retarget.depth.tracker import SkeletonTracker
+
+HAND_R, ELBOW_R = KINECT_V1.index("HandRight"), KINECT_V1.index("ElbowRight")
+
+
+@pytest.fixture(scope="module")
+def hand_on_face(shared_data):
+    from kinect_retarget.depth.synthetic import Scenario, render_sequence
+    return render_sequence(str(shared_data / "mocap_bvh" / "131_02.bvh"), str(shared_data / "meshes" / "makehuman"),
+                           Scenario(seed=5), start=400, frames=3)
+
+
+def _track(seq):
+    tracker = SkeletonTracker(gravity=seq.gravity)
+    return [tracker.update(seq.mm[i], seq.times[i]) for i in range(len(seq.mm))]
+
+
+def test_directions_cover_the_sphere():
+    assert np.allclose(np.linalg.norm(DIRECTIONS, axis=1), 1.0)
+    assert abs(DIRECTIONS.mean(axis=0)).max() < 0.02          # no side favoured
+    cos = DIRECTIONS @ DIRECTIONS.T - 2 * np.eye(len(DIRECTIONS))
+    assert np.degrees(np.arccos(cos.max(axis=1))).max() < 20   # no direction farther than 20 deg from another
+
+
+def test_hand_on_the_face_is_found(hand_on_face, monkeypatch):
+    gt = hand_on_face.joints
+    out = _track(hand_on_face)
+    hand = [np.linalg.norm(pos[HAND_R] - g[HAND_R]) for (pos, _), g in zip(out, gt)]
+    elbow = [np.linalg.norm(pos[ELBOW_R] - g[ELBOW_R]) for (pos, _), g in zip(out, gt)]
+    assert all(st[HAND_R] != TRACKED for _, st in out)             # honest: no extremity backs it
+    # the first frame has no history (and a default body height); the next ones settle on the arm
+    assert max(hand) < 0.25 and hand[-1] < 0.1 and max(elbow) < 0.12
+    # without the search the same frames leave the hand hanging at the hip
+    monkeypatch.setattr(skeleton_fit, "ARM_SEARCH", False)
+    pos, _ = _track(hand_on_face)[-1]
+    assert np.linalg.norm(pos[HAND_R] - gt[-1][HAND_R]) > 0.3
+
+
+def test_search_alone_finds_the_arm(hand_on_face, monkeypatch):
+    """With no previous pose to lean on, the depth alone places the raised arm."""
+    calls = []
+    real = skeleton_fit.search_arm
+
+    def spy(scorer, shoulder, l1, l2, lh, H, prev_elbow=None, prev_hand=None):
+        calls.append((scorer, shoulder, l1, l2, lh, H))
+        return real(scorer, shoulder, l1, l2, lh, H, prev_elbow, prev_hand)
+
+    monkeypatch.setattr(skeleton_fit, "search_arm", spy)
+    _track(hand_on_face)
+    scorer, shoulder, l1, l2, lh, H = calls[-1]     # the right arm (searched after the left) of the last frame
+    g = hand_on_face.joints[-1]
+    elbow, _, hand, _ = search_arm(scorer, shoulder, l1, l2, lh, H)
+    assert np.linalg.norm(hand - g[HAND_R]) < 0.2 and np.linalg.norm(elbow - g[ELBOW_R]) < 0.12
+    # and a pose across the chest (what the torso surface alone would allow) costs more than the found one
+    across = shoulder + np.array([-l1, 0.0, -0.1])
+    u = np.array([-1.0, 0.0, 0.0])
+    from kinect_retarget.depth.arm_search import _chain_cost
+    found_cost = _chain_cost(scorer, shoulder, _unit(elbow - shoulder)[None], _unit(hand - elbow)[None], l1, l2, lh, H)[0]
+    across_cost = _chain_cost(scorer, shoulder, u[None], u[None], l1, l2, lh, H)[0]
+    assert across_cost[0] > found_cost[0] + 1.0
+
+
+def _unit(v):
+    return v / np.linalg.norm(v)
