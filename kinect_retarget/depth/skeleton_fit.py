@@ -29,6 +29,9 @@ SIDE_ON_WIDTH = 0.165       # visible chest width / height below which the torso
 MID_NEEDS_SUPPORT = True    # an elbow/knee is tracked only where the depth image backs it (projective check)
 CONTINUITY_RADIUS = 0.25    # m a lone hand/foot may move from a tracked one and still be taken for it
 ARM_SEARCH = True           # arms without a hand extremity: search poses against the depth (arm_search)
+BORDER_CELLS = 2            # an extremity this close to the image's edge may be where the limb leaves it
+TRUNCATED_EXTEND = 0.5      # a limb leaving the image continues this fraction of its remaining reach
+W_MIDLINE = 1.0             # per metre a knee lies across the body's midline
 REACH_SLACK = 0.10          # m an extremity may lie beyond the limb's calibrated reach and still be its end
 
 
@@ -245,11 +248,16 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
                 end_p = (tip_p if end_p is None else end_p + inside(end))
                 mid_ls = level_set_centroid(xyz, de, d_end + l2, band(0.06), end_p, l2 + 0.1)
                 labels.append((f"{tip}{s}", e[1]))
+                truncated = _at_image_border(grid, (r0 + e[0][0] * k, c0 + e[0][1] * k))
+                if truncated:  # the limb leaves the image: its extremity is where the view ends, not the end
+                    reach_left = max(0.0, l1 + l2 - np.linalg.norm(end_p - a))
+                    out = _unit(e[1] - a) * TRUNCATED_EXTEND * reach_left
+                    end_p, tip_p = end_p + out, tip_p + out
                 # a true hand/foot lies a limb's length along the surface beyond its shoulder/hip; an
                 # elbow sticking out (hand on the face) or a knee is nearer: keep the guess, flag it
                 root_cell = _nearest_cell(xyz, mask, a)
                 along_limb = e[2] - (d0[root_cell] if root_cell is not None and np.isfinite(d0[root_cell]) else 0.0)
-                st_limb = TRACKED if along_limb > 0.7 * (l1 + l2) else INFERRED
+                st_limb = TRACKED if along_limb > 0.7 * (l1 + l2) and not truncated else INFERRED
                 if st_limb == INFERRED and root == "Shoulder":
                     # not a hand (an elbow, a shoulder): look for the arm as if no extremity was found
                     end_p, tip_p, mid_ls = without_extremity()
@@ -267,6 +275,8 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
                 cost = cost - 0.02 * ((cands - a) @ _unit(pref))
             if root == "Hip":  # knees only ever bend forwards: keep them off the back of the circle
                 cost = cost + 0.3 * np.maximum(0.0, -((cands - (a + end_p2) / 2) @ facing))
+                # and stay on their own side of the body (a knee across the midline is the other leg's)
+                cost = cost + W_MIDLINE * np.maximum(0.0, -(1.0 if s == "Left" else -1.0) * ((cands - centre) @ lat))
             m = cands[int(np.argmin(cost))]
             pos[J[f"{mid}{s}"]] = m
             reach_shift = end_p2 - end_p  # keep the hand/foot attached when the end was pulled into reach
@@ -287,6 +297,12 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
         for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
             st[J[name]] = INFERRED
     return FitResult(pos, st, lat, labels, centre, None if head is None else head[1], proj, edge_on or narrow)
+
+
+def _at_image_border(grid, rc) -> bool:
+    h, w = grid.valid.shape
+    r, c = rc
+    return bool(r >= h - 1 - BORDER_CELLS or c <= BORDER_CELLS or c >= w - 1 - BORDER_CELLS or r <= BORDER_CELLS)
 
 
 def _search_unseen_arms(pos, st, xyz, mask, proj, frame, H, prev) -> None:

@@ -56,3 +56,25 @@ def test_bad_frame_in_the_middle_then_recovery(rendered):
     pos, st = tr.update(seq.mm[5], seq.times[5])
     assert np.all(st != NOT_TRACKED)
     assert np.linalg.norm(pos[0] - seq.joints[5, 0]) < 0.12
+
+
+def test_feet_out_of_the_image_are_not_claimed(rendered, camera):
+    """The performer's shins end at the image's bottom edge (the frames moved down so the feet leave the
+    view, as when someone steps close): what the surface ends on there is not a foot, so the feet and ankles
+    are reported inferred, and placed below the edge rather than on it."""
+    seq, _ = rendered
+    from kinect_retarget.core.skeletons import KINECT_V1
+    foot, ankle = [KINECT_V1.index(f"Foot{s}") for s in ("Left", "Right")], \
+        [KINECT_V1.index(f"Ankle{s}") for s in ("Left", "Right")]
+    gt = seq.joints[0]
+    knee_row = camera.cy - camera.f * gt[KINECT_V1.index("KneeLeft"), 1] / gt[KINECT_V1.index("KneeLeft"), 2]
+    ankle_row = camera.cy - camera.f * gt[ankle[0], 1] / gt[ankle[0], 2]
+    shift = int(480 - (knee_row + ankle_row) / 2)          # the image now ends mid-shin
+    tracker = SkeletonTracker(gravity=seq.gravity)
+    for i in range(len(seq.mm)):
+        moved = np.zeros_like(seq.mm[i])
+        moved[shift:] = seq.mm[i][:-shift]
+        pos, st = tracker.update(moved, seq.times[i])
+        assert np.all(st[foot + ankle] != TRACKED), f"frame {i}: a foot claimed at the image's edge"
+        rows = camera.cy - camera.f * pos[foot, 1] / pos[foot, 2]
+        assert np.all(rows > 480 - 8)                      # continued past the edge, not stopped on it
