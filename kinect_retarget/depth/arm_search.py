@@ -50,6 +50,7 @@ IN_FRONT = 0.06        # m in front of the chest's surface: an arm, not the ches
 TORSO_BAND = 0.04      # fraction of height: bands of the trunk whose surface depth is taken apart
 HEAD_HALF_WIDTH = 0.065  # fraction of height: head and neck, above the shoulder line
 LEG_RADIUS = 0.09      # m around the fitted leg bones
+ARM_RADIUS = 0.08      # m around an arm already placed: its cells are not the other arm's evidence
 
 
 def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -101,6 +102,14 @@ def arm_evidence(xyz: np.ndarray, mask: np.ndarray, pos: np.ndarray, frame: Tors
         for a, b in (("Hip", "Knee"), ("Knee", "Ankle"), ("Ankle", "Foot")):
             ev &= _segment_distance(xyz, pos[J[f"{a}{s}"]], pos[J[f"{b}{s}"]]) > LEG_RADIUS
     return ev
+
+
+def near_arm(xyz: np.ndarray, pos: np.ndarray, side: str, radius: float = ARM_RADIUS) -> np.ndarray:
+    """Cells within `radius` of one arm's bones (shoulder to hand)."""
+    near = np.zeros(xyz.shape[:-1], bool)
+    for a, b in (("Shoulder", "Elbow"), ("Elbow", "Wrist"), ("Wrist", "Hand")):
+        near |= _segment_distance(xyz, pos[J[f"{a}{side}"]], pos[J[f"{b}{side}"]]) < radius
+    return near
 
 
 class ArmScorer:

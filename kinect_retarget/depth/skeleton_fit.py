@@ -15,7 +15,7 @@ import numpy as np
 
 from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED
 from . import body_model_fit as bm
-from .arm_search import ArmScorer, TorsoFrame, arm_evidence, search_arm
+from .arm_search import ArmScorer, TorsoFrame, arm_evidence, near_arm, search_arm
 from .geodesic import SurfaceGraph, geodesic_extrema, geodesic_maxima, level_set_centroid
 
 J = {n: i for i, n in enumerate(KINECT_V1.joints)}
@@ -28,6 +28,7 @@ AXIS_GRAVITY_WEIGHT = 0.75  # torso axis = this blend of gravity's up and the to
 SIDE_ON_WIDTH = 0.165       # visible chest width / height below which the torso is taken as seen side-on
 MID_NEEDS_SUPPORT = True    # an elbow/knee is tracked only where the depth image backs it (projective check)
 CONTINUITY_RADIUS = 0.25    # m a lone hand/foot may move from a tracked one and still be taken for it
+ARM_UNSEEN_COST = 0.1       # per-sample search cost above which no arm was seen (arm_search scale)
 ARM_SEARCH = True           # arms without a hand extremity: search poses against the depth (arm_search)
 BORDER_CELLS = 2            # an extremity this close to the image's edge may be where the limb leaves it
 TRUNCATED_EXTEND = 0.5      # a limb leaving the image continues this fraction of its remaining reach
@@ -306,16 +307,34 @@ def _at_image_border(grid, rc) -> bool:
 
 
 def _search_unseen_arms(pos, st, xyz, mask, proj, frame, H, prev) -> None:
-    """Arms whose hand is not a tracked extremity: the pose that best explains the depth (arm_search)."""
-    scorer = None
+    """Arms whose hand is not a tracked extremity: the pose that best explains the depth (arm_search).
+    Each arm explains its own cells: a tracked arm's are taken out first, and of two searched arms the
+    better-supported one keeps its cells while the other is searched again without them (a hidden far
+    arm must not borrow the near arm's)."""
+    todo = [s for s in SIDES if st[J[f"Hand{s}"]] != TRACKED]
+    if not todo:
+        return
+    evidence = arm_evidence(xyz, mask, pos, frame)
     for s in SIDES:
-        if st[J[f"Hand{s}"]] == TRACKED:
-            continue
-        if scorer is None:
-            scorer = ArmScorer(proj, arm_evidence(xyz, mask, pos, frame), frame)
+        if s not in todo:
+            evidence &= ~near_arm(xyz, pos, s)
+    lengths = (bm.UPPER_ARM * H, bm.FOREARM * H, bm.HAND * H)
+
+    def search(s, ev):
         pe, ph = (None, None) if prev is None else (prev[J[f"Elbow{s}"]], prev[J[f"Hand{s}"]])
-        e, w, h, _ = search_arm(scorer, pos[J[f"Shoulder{s}"]], bm.UPPER_ARM * H, bm.FOREARM * H, bm.HAND * H, H,
-                                pe, ph)
+        return search_arm(ArmScorer(proj, ev, frame), pos[J[f"Shoulder{s}"]], *lengths, H, pe, ph)
+
+    found = {s: search(s, evidence) for s in todo}
+    if len(todo) == 2:
+        first, second = sorted(todo, key=lambda s: found[s][3])
+        e, w, h, _ = found[first]
+        trial = pos.copy()
+        trial[J[f"Elbow{first}"]], trial[J[f"Wrist{first}"]], trial[J[f"Hand{first}"]] = e, w, h
+        found[second] = search(second, evidence & ~near_arm(xyz, trial, first))
+    for s in todo:
+        e, w, h, cost = found[s]
+        if cost > ARM_UNSEEN_COST:
+            continue  # nothing in view explains this arm (hidden behind the body): keep the carried guess
         pos[J[f"Elbow{s}"]], pos[J[f"Wrist{s}"]], pos[J[f"Hand{s}"]] = e, w, h
         st[[J[f"Elbow{s}"], J[f"Wrist{s}"], J[f"Hand{s}"]]] = INFERRED
 
