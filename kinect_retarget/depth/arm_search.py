@@ -186,3 +186,16 @@ def search_arm(scorer: ArmScorer, shoulder, l1, l2, lh, H, prev_elbow=None, prev
     cost = cost + prior(elbow, hand) + np.where(np.sum(uu * vv, -1) < FOLD_LIMIT, 10.0, 0.0)
     i, j = np.unravel_index(int(np.argmin(cost)), cost.shape)
     return elbow[i, j], wrist[i, j], hand[i, j], float(cost[i, j]) / n_samples
+
+
+def best_elbow(scorer: ArmScorer, shoulder, candidates: np.ndarray, wrist, H, prev_elbow=None):
+    """Of the elbows that join a known shoulder and wrist (two-bone IK circle), the one whose bones best
+    explain the depth -> (elbow, cost)."""
+    t_up, t_fore = UPPER_T[:, None], FORE_T[:, None]
+    cost = scorer.score([(shoulder + (candidates - shoulder)[:, None, :] * t_up, UPPER_R * H),
+                         (candidates[:, None, :] + (wrist - candidates)[:, None, :] * t_fore, FORE_R * H)])
+    cost = cost + INSIDE_COST * scorer.frame.inside(candidates)
+    if prev_elbow is not None:
+        cost = cost + W_PREVIOUS * (len(UPPER_T) + len(FORE_T)) * np.linalg.norm(candidates - prev_elbow, axis=1)
+    i = int(np.argmin(cost))
+    return candidates[i], float(cost[i])

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED
 from . import body_model_fit as bm
-from .arm_search import ArmScorer, TorsoFrame, arm_evidence, near_arm, search_arm
+from .arm_search import ArmScorer, TorsoFrame, arm_evidence, best_elbow, near_arm, search_arm
 from .geodesic import SurfaceGraph, geodesic_extrema, geodesic_maxima, level_set_centroid
 
 J = {n: i for i, n in enumerate(KINECT_V1.joints)}
@@ -28,10 +28,13 @@ AXIS_GRAVITY_WEIGHT = 0.75  # torso axis = this blend of gravity's up and the to
 SIDE_ON_WIDTH = 0.165       # visible chest width / height below which the torso is taken as seen side-on
 MID_NEEDS_SUPPORT = True    # an elbow/knee is tracked only where the depth image backs it (projective check)
 CONTINUITY_RADIUS = 0.25    # m a lone hand/foot may move from a tracked one and still be taken for it
+ELBOW_FROM_DEPTH = True     # tracked hands: the elbow on the IK circle chosen by arm_search's scoring
 ARM_UNSEEN_COST = 0.1       # per-sample search cost above which no arm was seen (arm_search scale)
 ARM_SEARCH = True           # arms without a hand extremity: search poses against the depth (arm_search)
 BORDER_CELLS = 2            # an extremity this close to the image's edge may be where the limb leaves it
 TRUNCATED_EXTEND = 0.5      # a limb leaving the image continues this fraction of its remaining reach
+OCCLUDED_ENDS = True        # an extremity beside a nearer surface is where the limb is hidden, not its end
+OCCLUDER_GAP = 0.06         # m nearer than the extremity for a neighbour to count as hiding the limb
 W_MIDLINE = 1.0             # per metre a knee lies across the body's midline
 REACH_SLACK = 0.10          # m an extremity may lie beyond the limb's calibrated reach and still be its end
 
@@ -249,8 +252,10 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
                 end_p = (tip_p if end_p is None else end_p + inside(end))
                 mid_ls = level_set_centroid(xyz, de, d_end + l2, band(0.06), end_p, l2 + 0.1)
                 labels.append((f"{tip}{s}", e[1]))
-                truncated = _at_image_border(grid, (r0 + e[0][0] * k, c0 + e[0][1] * k))
-                if truncated:  # the limb leaves the image: its extremity is where the view ends, not the end
+                truncated = _at_image_border(grid, (r0 + e[0][0] * k, c0 + e[0][1] * k)) \
+                    or (OCCLUDED_ENDS and _occluded_end(xyz, mask, e[0]))
+                if truncated:  # the limb leaves the image or goes behind the body: its extremity is where the
+                    # view ends, not where the limb does
                     reach_left = max(0.0, l1 + l2 - np.linalg.norm(end_p - a))
                     out = _unit(e[1] - a) * TRUNCATED_EXTEND * reach_left
                     end_p, tip_p = end_p + out, tip_p + out
@@ -306,19 +311,37 @@ def _at_image_border(grid, rc) -> bool:
     return bool(r >= h - 1 - BORDER_CELLS or c <= BORDER_CELLS or c >= w - 1 - BORDER_CELLS or r <= BORDER_CELLS)
 
 
+def _occluded_end(xyz, mask, rc, radius: int = 2) -> bool:
+    """The surface next to this extremity is nearer the sensor: the limb goes on behind it."""
+    r, c = rc
+    h, w = mask.shape
+    win = (slice(max(r - radius, 0), min(r + radius + 1, h)), slice(max(c - radius, 0), min(c + radius + 1, w)))
+    nearer = mask[win] & (xyz[win][..., 2] < xyz[r, c, 2] - OCCLUDER_GAP)
+    return int(nearer.sum()) >= 2
+
+
 def _search_unseen_arms(pos, st, xyz, mask, proj, frame, H, prev) -> None:
     """Arms whose hand is not a tracked extremity: the pose that best explains the depth (arm_search).
     Each arm explains its own cells: a tracked arm's are taken out first, and of two searched arms the
     better-supported one keeps its cells while the other is searched again without them (a hidden far
     arm must not borrow the near arm's)."""
     todo = [s for s in SIDES if st[J[f"Hand{s}"]] != TRACKED]
+    evidence = arm_evidence(xyz, mask, pos, frame)
+    lengths = (bm.UPPER_ARM * H, bm.FOREARM * H, bm.HAND * H)
+    if ELBOW_FROM_DEPTH:  # a tracked hand fixes the wrist; the elbow's place on its circle is the depth's call
+        for s in SIDES:
+            if s in todo:
+                continue
+            shoulder, wrist = pos[J[f"Shoulder{s}"]], pos[J[f"Wrist{s}"]]
+            cands, _ = two_bone_candidates(shoulder, wrist, lengths[0], lengths[1], n=24)
+            if len(cands) > 1:
+                pos[J[f"Elbow{s}"]], _ = best_elbow(ArmScorer(proj, evidence, frame), shoulder, cands, wrist, H,
+                                                    None if prev is None else prev[J[f"Elbow{s}"]])
     if not todo:
         return
-    evidence = arm_evidence(xyz, mask, pos, frame)
     for s in SIDES:
         if s not in todo:
             evidence &= ~near_arm(xyz, pos, s)
-    lengths = (bm.UPPER_ARM * H, bm.FOREARM * H, bm.HAND * H)
 
     def search(s, ev):
         pe, ph = (None, None) if prev is None else (prev[J[f"Elbow{s}"]], prev[J[f"Hand{s}"]])
