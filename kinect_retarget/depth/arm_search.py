@@ -92,12 +92,17 @@ class TorsoFrame:
         return (a > self.hip_a) & (a < self.shoulder_a) & (np.abs(l) < 0.08 * self.H) & (f < -0.03) & (f > -0.25)
 
 
-def arm_evidence(xyz: np.ndarray, mask: np.ndarray, pos: np.ndarray, frame: TorsoFrame) -> np.ndarray:
-    """Cells of the person that the torso, head and fitted legs leave unexplained."""
+def arm_evidence(xyz: np.ndarray, mask: np.ndarray, pos: np.ndarray, frame: TorsoFrame,
+                 head_region: np.ndarray | None = None) -> np.ndarray:
+    """Cells of the person that the torso, head and fitted legs leave unexplained. `head_region`: the
+    cells near the head along the surface, when the head was found (else a box above the shoulders)."""
     ev = mask & ~frame.torso(xyz, mask)
     a, l, f = frame.coords(xyz)
     face = (pos[J["Head"]] - frame.centre) @ frame.facing + 0.10   # the head joint sits 10 cm behind the face
-    ev &= ~((a > frame.shoulder_a - 0.03 * frame.H) & (np.abs(l) < HEAD_HALF_WIDTH * frame.H) & (f < face + IN_FRONT))
+    head = (a > frame.shoulder_a - 0.03 * frame.H) & (np.abs(l) < HEAD_HALF_WIDTH * frame.H)
+    if head_region is not None:
+        head |= head_region
+    ev &= ~(head & (f < face + IN_FRONT))   # a hand held in front of the face still counts
     for s in ("Left", "Right"):
         for a, b in (("Hip", "Knee"), ("Knee", "Ankle"), ("Ankle", "Foot")):
             ev &= _segment_distance(xyz, pos[J[f"{a}{s}"]], pos[J[f"{b}{s}"]]) > LEG_RADIUS

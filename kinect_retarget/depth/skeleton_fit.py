@@ -28,6 +28,7 @@ AXIS_GRAVITY_WEIGHT = 0.75  # torso axis = this blend of gravity's up and the to
 SIDE_ON_WIDTH = 0.165       # visible chest width / height below which the torso is taken as seen side-on
 MID_NEEDS_SUPPORT = True    # an elbow/knee is tracked only where the depth image backs it (projective check)
 CONTINUITY_RADIUS = 0.25    # m a lone hand/foot may move from a tracked one and still be taken for it
+HEAD_REGION = 0.12          # fraction of height along the surface from the head's extremum: head and neck
 ELBOW_FROM_DEPTH = True     # tracked hands: the elbow on the IK circle chosen by arm_search's scoring
 ARM_UNSEEN_COST = 0.1       # per-sample search cost above which no arm was seen (arm_search scale)
 ARM_SEARCH = True           # arms without a hand extremity: search poses against the depth (arm_search)
@@ -201,8 +202,10 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     hands = sorted([e for e in rest if e not in feet and e[3] > -0.35 * H and e[2] > 0.22 * H],
                    key=lambda e: -e[2])[:2]
     labels = []
+    head_region = None
     if head is not None:
         dh = graph.distances(np.array([head[0]]), iterations=3)
+        head_region = dh < HEAD_REGION * H
         hc = level_set_centroid(xyz, dh, 0.06 * H, band(0.04), head[1], 0.2)
         pos[J["Head"]] = (hc if hc is not None else head[1] - axis * 0.05 * H) + inside("Head")
         st[J["Head"]] = TRACKED
@@ -294,7 +297,8 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
             st[J[f"{mid}{s}"]] = TRACKED if mid_ok or (st_limb == TRACKED and not MID_NEEDS_SUPPORT) else INFERRED
             st[J[f"{end}{s}"]] = st[J[f"{tip}{s}"]] = st_limb
     if ARM_SEARCH:
-        _search_unseen_arms(pos, st, xyz, mask, proj, TorsoFrame(centre, axis, lat, facing, pos, H), H, prev)
+        _search_unseen_arms(pos, st, xyz, mask, proj, TorsoFrame(centre, axis, lat, facing, pos, H), H, prev,
+                            head_region)
     # without the head top or the shoulders the torso's place along its axis is a guess; seen more than
     # 45 degrees from the front, shoulders and hips overlap in depth: say so instead of claiming them
     if shift is None:
@@ -320,13 +324,13 @@ def _occluded_end(xyz, mask, rc, radius: int = 2) -> bool:
     return int(nearer.sum()) >= 2
 
 
-def _search_unseen_arms(pos, st, xyz, mask, proj, frame, H, prev) -> None:
+def _search_unseen_arms(pos, st, xyz, mask, proj, frame, H, prev, head_region=None) -> None:
     """Arms whose hand is not a tracked extremity: the pose that best explains the depth (arm_search).
     Each arm explains its own cells: a tracked arm's are taken out first, and of two searched arms the
     better-supported one keeps its cells while the other is searched again without them (a hidden far
     arm must not borrow the near arm's)."""
     todo = [s for s in SIDES if st[J[f"Hand{s}"]] != TRACKED]
-    evidence = arm_evidence(xyz, mask, pos, frame)
+    evidence = arm_evidence(xyz, mask, pos, frame, head_region)
     lengths = (bm.UPPER_ARM * H, bm.FOREARM * H, bm.HAND * H)
     if ELBOW_FROM_DEPTH:  # a tracked hand fixes the wrist; the elbow's place on its circle is the depth's call
         for s in SIDES:
