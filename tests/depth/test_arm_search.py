@@ -76,3 +76,47 @@ def test_search_alone_finds_the_arm(hand_on_face, monkeypatch):
 
 def _unit(v):
     return v / np.linalg.norm(v)
+
+
+def test_best_elbow_on_the_ik_circle_follows_the_depth(hand_on_face, monkeypatch):
+    """Shoulder and wrist known (the ground truth's): of the elbows on their IK circle, the one the depth
+    backs is the true one, although most of the circle lies on the body's surface too."""
+    from kinect_retarget.depth import arm_search
+    from kinect_retarget.depth.skeleton_fit import two_bone_candidates
+    scorers = []
+    real = arm_search.ArmScorer.__init__
+
+    def keep(self, *args, **kw):
+        real(self, *args, **kw)
+        scorers.append(self)
+
+    monkeypatch.setattr(arm_search.ArmScorer, "__init__", keep)
+    _track(hand_on_face)
+    g = hand_on_face.joints[-1]
+    s, e, w = (g[KINECT_V1.index(f"{n}Right")] for n in ("Shoulder", "Elbow", "Wrist"))
+    cands, _ = two_bone_candidates(s, w, np.linalg.norm(e - s), np.linalg.norm(w - e), n=24)
+    assert np.max(np.linalg.norm(cands - e, axis=1)) > 0.2        # a wrong choice would show
+    elbow, _ = arm_search.best_elbow(scorers[-1], s, cands, w, 1.67)
+    assert np.linalg.norm(elbow - e) < 0.06
+
+
+def test_the_head_is_not_arm_evidence(hand_on_face, monkeypatch):
+    """Cells around the head along the surface are the head's, not an arm's, unless in front of the face."""
+    from kinect_retarget.depth import arm_search
+    calls = []
+    real = arm_search.arm_evidence
+
+    def spy(xyz, mask, pos, frame, head_region=None):
+        ev = real(xyz, mask, pos, frame, head_region)
+        calls.append((xyz, mask, pos, ev, head_region))
+        return ev
+
+    monkeypatch.setattr(skeleton_fit, "arm_evidence", spy)
+    _track(hand_on_face)
+    xyz, mask, pos, ev, head_region = calls[-1]
+    assert head_region is not None and head_region.sum() > 10
+    top = np.linalg.norm(xyz - pos[KINECT_V1.index("Head")], axis=-1) < 0.08
+    assert not np.any(ev & top & mask & (xyz[..., 2] > pos[KINECT_V1.index("Head"), 2] - 0.12))
+    g = hand_on_face.joints[-1]
+    near_hand = mask & (np.linalg.norm(xyz - g[HAND_R], axis=-1) < 0.08)
+    assert np.mean(ev[near_hand]) > 0.3     # the hand held to the face still counts for its arm
