@@ -41,6 +41,7 @@ SCENARIOS = {
     "enter+leave": ("131_02", 0, 150, Scenario(enter_exit=True, seed=4)),
     "arm occluded (turned 60 deg)": ("131_02", 0, 150, Scenario(turn_deg=60.0, seed=8)),
 }
+ISSUE_MOTIONS = ("walk", "hop", "jumps")   # the motions issue 5's goals name; the turns are our harder extra
 FRONTAL_DEG = 45.0   # the SDK's design range: the performer faces the sensor
 # Development subset: the first half of every motion's frames; tuning looks only at these figures. The second
 # half is held out (tracked in the same run, since the tracker needs the history, but scored separately).
@@ -95,7 +96,7 @@ def main() -> None:
     args = ap.parse_args()
     only = set(args.only.split(",")) if args.only else None
     print("depth tracking benchmark (640x480 input, one thread; errors in cm)")
-    all_lat, errs, frontal_errs = [], [], []
+    all_lat, errs, frontal_errs, named = [], [], [], {}
     split = {"dev": [], "held-out": []}
     for name, (clip, start, frames, scen) in MOTIONS.items():
         if only and name not in only:
@@ -114,6 +115,7 @@ def main() -> None:
         front = present & (facing_angle(gt) < FRONTAL_DEG)
         scf = score(pos, st, gt, front)
         errs.append(sc.mean_error)
+        named[name] = sc
         frontal_errs.append(scf.mean_error)
         worst = np.argsort(sc.per_joint)[::-1][:3]
         print(f"{name:11s} {clip} ({len(pos)} frames, {front.mean() * 100:.0f} % frontal): mean error "
@@ -124,8 +126,15 @@ def main() -> None:
               + ", ".join(f"{KINECT_V1.joints[j]} {sc.per_joint[j] * 100:.0f}" for j in worst), flush=True)
     if errs:
         lat = np.concatenate(all_lat)
-        print(f"overall mean error {np.mean(errs) * 100:.1f} cm, frontal frames {np.mean(frontal_errs) * 100:.1f} cm "
-              f"(goal <= 8)")
+        issue = [named[n] for n in ISSUE_MOTIONS if n in named]
+        if issue:
+            print(f"issue 5's motions ({', '.join(n for n in ISSUE_MOTIONS if n in named)}): mean error "
+                  f"{np.mean([x.mean_error for x in issue]) * 100:.1f} cm (goal <= 8; each "
+                  + " / ".join(f"{x.mean_error * 100:.1f}" for x in issue) + ") | within 15 cm or flagged "
+                  + " / ".join(f"{x.within_or_flagged * 100:.1f}" for x in issue) + " % | swaps >3 frames "
+                  + " / ".join(str(x.swaps_over_3) for x in issue), flush=True)
+        print(f"all motions (with the turns): mean error {np.mean(errs) * 100:.1f} cm, frontal frames "
+              f"{np.mean(frontal_errs) * 100:.1f} cm")
         for part, scs in split.items():
             print(f"  {part:8s} (each motion's {'first' if part == 'dev' else 'second'} half): mean error "
                   f"{np.mean([x.mean_error for x in scs]) * 100:.1f} cm | within 15 cm or flagged "
