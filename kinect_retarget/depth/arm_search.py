@@ -31,7 +31,7 @@ def _sphere(n: int) -> np.ndarray:
 
 DIRECTIONS = _sphere(160)          # about 16 degrees apart
 REFINE = _sphere(24) * 0.14        # offsets of a refinement cone, about 8 degrees
-UPPER_KEEP = 8                     # upper-arm directions carried into the forearm search
+UPPER_KEEP = 6                     # upper-arm directions carried into the forearm search
 FOLD_LIMIT = -0.85                 # cos of the tightest elbow fold allowed between upper arm and forearm
 # sample points along each bone (fraction of its length) and the bone's radius (fraction of height)
 UPPER_T, UPPER_R = np.array([0.4, 0.6, 0.8, 1.0]), 0.026

@@ -363,10 +363,12 @@ def _search_unseen_arms(pos, st, xyz, mask, proj, frame, H, prev, head_region=No
     found = {s: search(s, evidence) for s in todo}
     if len(todo) == 2:
         first, second = sorted(todo, key=lambda s: found[s][3])
-        e, w, h, _ = found[first]
         trial = pos.copy()
-        trial[J[f"Elbow{first}"]], trial[J[f"Wrist{first}"]], trial[J[f"Hand{first}"]] = e, w, h
-        found[second] = search(second, evidence & ~near_arm(xyz, trial, first))
+        for s in todo:
+            trial[J[f"Elbow{s}"]], trial[J[f"Wrist{s}"]], trial[J[f"Hand{s}"]] = found[s][:3]
+        taken = evidence & near_arm(xyz, trial, first)
+        if np.any(taken & near_arm(xyz, trial, second)):  # both claim the same cells: the weaker looks again
+            found[second] = search(second, evidence & ~taken)
     for s in todo:
         e, w, h, cost = found[s]
         if cost > ARM_UNSEEN_COST:
