@@ -25,6 +25,7 @@ GEODESIC_ROWS = 1000   # no subsampling below the tracker's grid: coarser cells 
 EXTREMA = "plagemann"     # "maxima" (one geodesic run) or "plagemann" (one run per extremum, slower)
 SIDES = ("Left", "Right")
 HEAD_AXIS_WEIGHT = 0.65      # torso axis pulled this far toward the line from the torso patch to the head top
+MAX_SIDE_LEAN_DEG = 20.0    # sideways component of a lean beyond which the "head" is not trusted to tilt
 MAX_LEAN_DEG = 60.0         # a "head" farther than this from upright is taken for something else
 AXIS_GRAVITY_WEIGHT = 0.75  # torso axis = this blend of gravity's up and the torso patch's long axis
 SIDE_ON_WIDTH = 0.165       # visible chest width / height below which the torso is taken as seen side-on
@@ -174,16 +175,22 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     if head is not None:
         # the geodesic extremum lies anywhere on the skull; the top is the highest point near it
         near = xyz[mask & (np.linalg.norm(xyz - head[1], axis=-1) < 0.15)]
-        top = near[np.argmax(near @ axis)] if len(near) else head[1]
+        def anchor(ax):
+            t = near[np.argmax(near @ ax)] if len(near) else head[1]
+            return t, (t - ax * (1.0 - calib.torso_patch_height) * H - centre) @ ax
+
+        top, shift = anchor(axis)
         lean = _unit(top - centre)
-        if HEAD_AXIS_WEIGHT > 0 and lean @ up > np.cos(np.radians(MAX_LEAN_DEG)):
-            # the trunk leans (a crouch, a bow): the line from the torso patch to the head top says how far
-            axis = _unit(HEAD_AXIS_WEIGHT * lean + (1 - HEAD_AXIS_WEIGHT) * axis)
-            lat = _unit(lat - (lat @ axis) * axis)
-            facing = _unit(np.cross(lat, axis))
-            top = near[np.argmax(near @ axis)] if len(near) else head[1]
-        anchored = top - axis * (1.0 - calib.torso_patch_height) * H
-        shift = (anchored - centre) @ axis
+        # the trunk leans (a crouch, a bow): the line from the torso patch to the head top says how far. A bow
+        # leans forward; a "head" off to the side or behind is more likely a hand, and tilts nothing
+        forward = lean @ facing > 0 and abs(lean @ lat) < np.sin(np.radians(MAX_SIDE_LEAN_DEG))
+        if HEAD_AXIS_WEIGHT > 0 and forward and lean @ up > np.cos(np.radians(MAX_LEAN_DEG)):
+            leaned = _unit(HEAD_AXIS_WEIGHT * lean + (1 - HEAD_AXIS_WEIGHT) * axis)
+            l_top, l_shift = anchor(leaned)
+            if abs(l_shift) <= 0.15:
+                axis, top, shift = leaned, l_top, l_shift
+                lat = _unit(lat - (lat @ axis) * axis)
+                facing = _unit(np.cross(lat, axis))
         if abs(shift) > 0.15:  # not the head (a shoulder or raised hand): the torso cannot move that far
             head, shift = None, None
     else:
