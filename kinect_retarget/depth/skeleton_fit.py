@@ -40,6 +40,7 @@ TRUNCATED_EXTEND = 0.5      # a limb leaving the image continues this fraction o
 OCCLUDED_ENDS = True        # an extremity beside a nearer surface is where the limb is hidden, not its end
 OCCLUDER_GAP = 0.06         # m nearer than the extremity for a neighbour to count as hiding the limb
 W_MIDLINE = 1.0             # per metre a knee lies across the body's midline
+PREDICTED_SIDES = True      # left/right continuity against the motion's prediction, not the last position
 REACH_SLACK = 0.10          # m an extremity may lie beyond the limb's calibrated reach and still be its end
 
 
@@ -113,7 +114,9 @@ def two_bone_candidates(a: np.ndarray, c: np.ndarray, l1: float, l2: float, n: i
 
 def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_states: np.ndarray | None,
                prev_lateral: np.ndarray | None, prev_centre: np.ndarray | None = None,
-               prev_head_top: np.ndarray | None = None) -> FitResult | None:
+               prev_head_top: np.ndarray | None = None, predicted: np.ndarray | None = None) -> FitResult | None:
+    """One frame's skeleton for the segmented person. `prev`/`prev_states`/`prev_lateral`: the last output;
+    `predicted`: where the motion so far says the joints are now (continuity for left/right labels)."""
     rows, cols = np.nonzero(mask_full)
     r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
     # geodesics on a grid about 60 cells tall whatever the distance: constant cost per frame
@@ -237,7 +240,8 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     limb_specs = (("Shoulder", "Elbow", "Wrist", "Hand", bm.UPPER_ARM, bm.FOREARM, hands, 0.08, 0.08 + bm.HAND * H),
                   ("Hip", "Knee", "Ankle", "Foot", bm.THIGH, bm.SHIN, feet, 0.07, 0.15))
     for root, mid, end, tip, r1, r2, found, d_tip, d_end in limb_specs:
-        assign = _assign_sides(found, prev, prev_states, tip, lat, centre)
+        assign = _assign_sides(found, prev if predicted is None or not PREDICTED_SIDES else predicted, prev_states,
+                               tip, lat, centre)
         for s in SIDES:
             e = assign.get(s)
             a = pos[J[f"{root}{s}"]]

@@ -98,7 +98,7 @@ class SkeletonTracker:
         last = self.last_good
         fit = fit_person(grid, person.mask, self.floor, up, self.calibration, self._prev, self._prev_states,
                          self._lateral, None if last is None else last.torso_centre,
-                         None if last is None else last.head_top)
+                         None if last is None else last.head_top, self.confidence.predict())
         if fit is None or not np.all(np.isfinite(fit.positions)):
             self._lose(ts)
             return self._none("person found but no skeleton fitted")
