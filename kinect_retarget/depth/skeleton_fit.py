@@ -41,6 +41,7 @@ OCCLUDED_ENDS = True        # an extremity beside a nearer surface is where the 
 OCCLUDER_GAP = 0.06         # m nearer than the extremity for a neighbour to count as hiding the limb
 W_MIDLINE = 1.0             # per metre a knee lies across the body's midline
 PREDICTED_SIDES = True      # left/right continuity against the motion's prediction, not the last position
+BEHIND_FREE, BEHIND_COST = 0.06, 0.5   # m behind the surface a joint may sit for free; cost per metre beyond
 REACH_SLACK = 0.10          # m an extremity may lie beyond the limb's calibrated reach and still be its end
 
 
@@ -84,7 +85,9 @@ class Projector:
         on = ok & self.mask[r, c]
         zs = self.xyz[r, c, 2]
         dz = pts[:, 2] - (zs + inside)
-        cost = np.where(on, np.where(dz < -0.04, -dz, np.where(dz > 0.2, 0.08, 0.0)), 0.25)
+        # in front of the surface: impossible; well behind it: only if something nearer hides it (mild cost)
+        behind = np.clip(BEHIND_COST * (dz - BEHIND_FREE), 0.0, 0.08)
+        cost = np.where(on, np.where(dz < -0.04, -dz, behind), 0.25)
         return cost
 
     def supported(self, p: np.ndarray, inside: float) -> bool:
