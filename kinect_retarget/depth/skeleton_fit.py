@@ -76,19 +76,21 @@ class Projector:
     def __init__(self, grid, crop, xyz, mask):
         self.grid, self.r0, self.c0, self.k, self.xyz, self.mask = grid, crop[0], crop[1], crop[2], xyz, mask
 
-    def cost(self, pts: np.ndarray, inside: float) -> np.ndarray:
+    def depth_offset(self, pts: np.ndarray, inside) -> tuple[np.ndarray, np.ndarray]:
+        """(dz, on): how far each point lies behind the surface seen at its pixel, less `inside` (the joint's
+        depth below the skin), and whether that pixel is on the person."""
         rc = np.round((self.grid.to_pixel(pts) - [self.r0, self.c0]) / self.k).astype(np.int64)
         h, w = self.mask.shape
         ok = (rc[:, 0] >= 0) & (rc[:, 0] < h) & (rc[:, 1] >= 0) & (rc[:, 1] < w)
         r = np.clip(rc[:, 0], 0, h - 1)
         c = np.clip(rc[:, 1], 0, w - 1)
-        on = ok & self.mask[r, c]
-        zs = self.xyz[r, c, 2]
-        dz = pts[:, 2] - (zs + inside)
+        return pts[:, 2] - (self.xyz[r, c, 2] + inside), ok & self.mask[r, c]
+
+    def cost(self, pts: np.ndarray, inside) -> np.ndarray:
+        dz, on = self.depth_offset(pts, inside)
         # in front of the surface: impossible; well behind it: only if something nearer hides it (mild cost)
         behind = np.clip(BEHIND_COST * (dz - BEHIND_FREE), 0.0, 0.08)
-        cost = np.where(on, np.where(dz < -0.04, -dz, behind), 0.25)
-        return cost
+        return np.where(on, np.where(dz < -0.04, -dz, behind), 0.25)
 
     def supported(self, p: np.ndarray, inside: float) -> bool:
         return bool(self.cost(p[None], inside)[0] < 0.05)
