@@ -16,9 +16,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.skeletons import KINECT_V1
+from ..core.skeletons import INFERRED, KINECT_V1, TRACKED
+from . import body_model_fit as bm
+from .two_bone import two_bone_candidates
 
 J = {n: i for i, n in enumerate(KINECT_V1.joints)}
+SIDES = ("Left", "Right")
 
 
 def _sphere(n: int) -> np.ndarray:
@@ -50,6 +53,8 @@ IN_FRONT = 0.06        # m in front of the chest's surface: an arm, not the ches
 TORSO_BAND = 0.04      # fraction of height: bands of the trunk whose surface depth is taken apart
 HEAD_HALF_WIDTH = 0.065  # fraction of height: head and neck, above the shoulder line
 LEG_RADIUS = 0.09      # m around the fitted leg bones
+ELBOW_FROM_DEPTH = True    # tracked hands: the elbow on the IK circle chosen by this scoring
+ARM_UNSEEN_COST = 0.1      # per-sample search cost above which no arm was seen (hidden: keep the carried pose)
 ARM_RADIUS = 0.08      # m around an arm already placed: its cells are not the other arm's evidence
 
 
@@ -204,3 +209,48 @@ def best_elbow(scorer: ArmScorer, shoulder, candidates: np.ndarray, wrist, H, pr
         cost = cost + W_PREVIOUS * (len(UPPER_T) + len(FORE_T)) * np.linalg.norm(candidates - prev_elbow, axis=1)
     i = int(np.argmin(cost))
     return candidates[i], float(cost[i])
+
+
+def fit_arms(pos, st, xyz, mask, proj, frame: TorsoFrame, H, prev=None, head_region=None) -> None:
+    """The arms of one fitted frame, in place (`pos`, `st`: the fit's 20 joints and states). A tracked hand
+    keeps its wrist and gets the elbow its IK circle's depth backs; an arm whose hand is not a tracked
+    extremity gets the pose that best explains the depth, reported inferred. Each arm explains its own
+    cells: a tracked arm's are withheld, and when two searched arms claim the same cells the weaker looks
+    again without them (a hidden far arm must not borrow the near arm's)."""
+    todo = [s for s in SIDES if st[J[f"Hand{s}"]] != TRACKED]
+    evidence = arm_evidence(xyz, mask, pos, frame, head_region)
+    lengths = (bm.UPPER_ARM * H, bm.FOREARM * H, bm.HAND * H)
+    if ELBOW_FROM_DEPTH:  # a tracked hand fixes the wrist; the elbow's place on its circle is the depth's call
+        for s in SIDES:
+            if s in todo:
+                continue
+            shoulder, wrist = pos[J[f"Shoulder{s}"]], pos[J[f"Wrist{s}"]]
+            cands, _ = two_bone_candidates(shoulder, wrist, lengths[0], lengths[1], n=24)
+            if len(cands) > 1:
+                pos[J[f"Elbow{s}"]], _ = best_elbow(ArmScorer(proj, evidence, frame), shoulder, cands, wrist, H,
+                                                    None if prev is None else prev[J[f"Elbow{s}"]])
+    if not todo:
+        return
+    for s in SIDES:
+        if s not in todo:
+            evidence &= ~near_arm(xyz, pos, s)
+
+    def search(s, ev):
+        pe, ph = (None, None) if prev is None else (prev[J[f"Elbow{s}"]], prev[J[f"Hand{s}"]])
+        return search_arm(ArmScorer(proj, ev, frame), pos[J[f"Shoulder{s}"]], *lengths, H, pe, ph)
+
+    found = {s: search(s, evidence) for s in todo}
+    if len(todo) == 2:
+        first, second = sorted(todo, key=lambda s: found[s][3])
+        trial = pos.copy()
+        for s in todo:
+            trial[J[f"Elbow{s}"]], trial[J[f"Wrist{s}"]], trial[J[f"Hand{s}"]] = found[s][:3]
+        taken = evidence & near_arm(xyz, trial, first)
+        if np.any(taken & near_arm(xyz, trial, second)):  # both claim the same cells: the weaker looks again
+            found[second] = search(second, evidence & ~taken)
+    for s in todo:
+        e, w, h, cost = found[s]
+        if cost > ARM_UNSEEN_COST:
+            continue  # nothing in view explains this arm (hidden behind the body): keep the carried guess
+        pos[J[f"Elbow{s}"]], pos[J[f"Wrist{s}"]], pos[J[f"Hand{s}"]] = e, w, h
+        st[[J[f"Elbow{s}"], J[f"Wrist{s}"], J[f"Hand{s}"]]] = INFERRED

@@ -4,8 +4,10 @@ Per frame: a torso patch (geodesic disc around the previous spine) gives the tor
 extrema give head, hand and foot candidates; level-set centroids (paper 003) near each extremity give
 hand/wrist and foot/ankle; elbows and knees come from two-bone inverse kinematics with the calibrated
 bone lengths, choosing on the IK circle the point that best agrees with the depth image (projective
-check), the level-set centroid and the previous frame. Limbs without evidence keep their previous pose
-relative to the torso and are reported inferred.
+check), the level-set centroid and the previous frame. An extremity at the image's edge or beside a nearer
+surface is where the view of the limb ends (limb_ends). Arms are then fitted against the depth
+(arm_search): the elbow of a tracked hand, and the whole of an arm whose hand is not a tracked extremity.
+Legs without evidence keep their previous pose relative to the torso; both are reported inferred.
 """
 from __future__ import annotations
 
@@ -15,8 +17,10 @@ import numpy as np
 
 from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED
 from . import body_model_fit as bm
-from .arm_search import ArmScorer, TorsoFrame, arm_evidence, best_elbow, near_arm, search_arm
+from .arm_search import TorsoFrame, fit_arms
 from .geodesic import SurfaceGraph, geodesic_extrema, geodesic_maxima, level_set_centroid
+from .limb_ends import at_image_border, occluded_end
+from .two_bone import two_bone_candidates
 
 J = {n: i for i, n in enumerate(KINECT_V1.joints)}
 # weights of the elbow/knee choice on the IK circle (per metre): level-set centroid, previous frame
@@ -32,13 +36,9 @@ SIDE_ON_WIDTH = 0.165       # visible chest width / height below which the torso
 MID_NEEDS_SUPPORT = True    # an elbow/knee is tracked only where the depth image backs it (projective check)
 CONTINUITY_RADIUS = 0.25    # m a lone hand/foot may move from a tracked one and still be taken for it
 HEAD_REGION = 0.12          # fraction of height along the surface from the head's extremum: head and neck
-ELBOW_FROM_DEPTH = True     # tracked hands: the elbow on the IK circle chosen by arm_search's scoring
-ARM_UNSEEN_COST = 0.1       # per-sample search cost above which no arm was seen (arm_search scale)
 ARM_SEARCH = True           # arms without a hand extremity: search poses against the depth (arm_search)
-BORDER_CELLS = 2            # an extremity this close to the image's edge may be where the limb leaves it
 TRUNCATED_EXTEND = 0.5      # a limb leaving the image continues this fraction of its remaining reach
 OCCLUDED_ENDS = True        # an extremity beside a nearer surface is where the limb is hidden, not its end
-OCCLUDER_GAP = 0.06         # m nearer than the extremity for a neighbour to count as hiding the limb
 W_MIDLINE = 1.0             # per metre a knee lies across the body's midline
 PREDICTED_SIDES = True      # left/right continuity against the motion's prediction, not the last position
 BEHIND_FREE, BEHIND_COST = 0.06, 0.5   # m behind the surface a joint may sit for free; cost per metre beyond
@@ -94,27 +94,6 @@ class Projector:
 
     def supported(self, p: np.ndarray, inside: float) -> bool:
         return bool(self.cost(p[None], inside)[0] < 0.05)
-
-
-def two_bone_candidates(a: np.ndarray, c: np.ndarray, l1: float, l2: float, n: int = 16):
-    """Middle-joint candidates (n, 3) for root a, end c and bone lengths l1, l2, plus the end clamped to
-    reach."""
-    v = c - a
-    d = np.linalg.norm(v)
-    if d < 1e-6:
-        v, d = np.array([0.0, -1.0, 0.0]), 1e-6
-    u = v / d
-    if d >= l1 + l2 - 1e-6:  # out of reach: straight limb
-        return (a + u * l1)[None], a + u * (l1 + l2)
-    if d <= abs(l1 - l2):
-        d = abs(l1 - l2) + 1e-6
-    x = (d * d + l1 * l1 - l2 * l2) / (2 * d)
-    r = np.sqrt(max(l1 * l1 - x * x, 0.0))
-    ref = np.array([0.0, 0.0, 1.0]) if abs(u[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
-    e1 = _unit(np.cross(u, ref))
-    e2 = np.cross(u, e1)
-    ang = np.linspace(0, 2 * np.pi, n, endpoint=False)
-    return a + u * x + r * (np.cos(ang)[:, None] * e1 + np.sin(ang)[:, None] * e2), a + u * d
 
 
 def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_states: np.ndarray | None,
@@ -280,8 +259,8 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
                 end_p = (tip_p if end_p is None else end_p + inside(end))
                 mid_ls = level_set_centroid(xyz, de, d_end + l2, band(0.06), end_p, l2 + 0.1)
                 labels.append((f"{tip}{s}", e[1]))
-                truncated = _at_image_border(grid, (r0 + e[0][0] * k, c0 + e[0][1] * k)) \
-                    or (OCCLUDED_ENDS and _occluded_end(xyz, mask, e[0]))
+                truncated = at_image_border(grid, (r0 + e[0][0] * k, c0 + e[0][1] * k)) \
+                    or (OCCLUDED_ENDS and occluded_end(xyz, mask, e[0]))
                 if truncated:  # the limb leaves the image or goes behind the body: its extremity is where the
                     # view ends, not where the limb does
                     reach_left = max(0.0, l1 + l2 - np.linalg.norm(end_p - a))
@@ -322,8 +301,7 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
             st[J[f"{mid}{s}"]] = TRACKED if mid_ok or (st_limb == TRACKED and not MID_NEEDS_SUPPORT) else INFERRED
             st[J[f"{end}{s}"]] = st[J[f"{tip}{s}"]] = st_limb
     if ARM_SEARCH:
-        _search_unseen_arms(pos, st, xyz, mask, proj, TorsoFrame(centre, axis, lat, facing, pos, H), H, prev,
-                            head_region)
+        fit_arms(pos, st, xyz, mask, proj, TorsoFrame(centre, axis, lat, facing, pos, H), H, prev, head_region)
     # without the head top or the shoulders the torso's place along its axis is a guess; seen more than
     # 45 degrees from the front, shoulders and hips overlap in depth: say so instead of claiming them
     if shift is None:
@@ -332,65 +310,6 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
         for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
             st[J[name]] = INFERRED
     return FitResult(pos, st, lat, labels, centre, None if head is None else head[1], proj, edge_on or narrow)
-
-
-def _at_image_border(grid, rc) -> bool:
-    h, w = grid.valid.shape
-    r, c = rc
-    return bool(r >= h - 1 - BORDER_CELLS or c <= BORDER_CELLS or c >= w - 1 - BORDER_CELLS or r <= BORDER_CELLS)
-
-
-def _occluded_end(xyz, mask, rc, radius: int = 2) -> bool:
-    """The surface next to this extremity is nearer the sensor: the limb goes on behind it."""
-    r, c = rc
-    h, w = mask.shape
-    win = (slice(max(r - radius, 0), min(r + radius + 1, h)), slice(max(c - radius, 0), min(c + radius + 1, w)))
-    nearer = mask[win] & (xyz[win][..., 2] < xyz[r, c, 2] - OCCLUDER_GAP)
-    return int(nearer.sum()) >= 2
-
-
-def _search_unseen_arms(pos, st, xyz, mask, proj, frame, H, prev, head_region=None) -> None:
-    """Arms whose hand is not a tracked extremity: the pose that best explains the depth (arm_search).
-    Each arm explains its own cells: a tracked arm's are taken out first, and of two searched arms the
-    better-supported one keeps its cells while the other is searched again without them (a hidden far
-    arm must not borrow the near arm's)."""
-    todo = [s for s in SIDES if st[J[f"Hand{s}"]] != TRACKED]
-    evidence = arm_evidence(xyz, mask, pos, frame, head_region)
-    lengths = (bm.UPPER_ARM * H, bm.FOREARM * H, bm.HAND * H)
-    if ELBOW_FROM_DEPTH:  # a tracked hand fixes the wrist; the elbow's place on its circle is the depth's call
-        for s in SIDES:
-            if s in todo:
-                continue
-            shoulder, wrist = pos[J[f"Shoulder{s}"]], pos[J[f"Wrist{s}"]]
-            cands, _ = two_bone_candidates(shoulder, wrist, lengths[0], lengths[1], n=24)
-            if len(cands) > 1:
-                pos[J[f"Elbow{s}"]], _ = best_elbow(ArmScorer(proj, evidence, frame), shoulder, cands, wrist, H,
-                                                    None if prev is None else prev[J[f"Elbow{s}"]])
-    if not todo:
-        return
-    for s in SIDES:
-        if s not in todo:
-            evidence &= ~near_arm(xyz, pos, s)
-
-    def search(s, ev):
-        pe, ph = (None, None) if prev is None else (prev[J[f"Elbow{s}"]], prev[J[f"Hand{s}"]])
-        return search_arm(ArmScorer(proj, ev, frame), pos[J[f"Shoulder{s}"]], *lengths, H, pe, ph)
-
-    found = {s: search(s, evidence) for s in todo}
-    if len(todo) == 2:
-        first, second = sorted(todo, key=lambda s: found[s][3])
-        trial = pos.copy()
-        for s in todo:
-            trial[J[f"Elbow{s}"]], trial[J[f"Wrist{s}"]], trial[J[f"Hand{s}"]] = found[s][:3]
-        taken = evidence & near_arm(xyz, trial, first)
-        if np.any(taken & near_arm(xyz, trial, second)):  # both claim the same cells: the weaker looks again
-            found[second] = search(second, evidence & ~taken)
-    for s in todo:
-        e, w, h, cost = found[s]
-        if cost > ARM_UNSEEN_COST:
-            continue  # nothing in view explains this arm (hidden behind the body): keep the carried guess
-        pos[J[f"Elbow{s}"]], pos[J[f"Wrist{s}"]], pos[J[f"Hand{s}"]] = e, w, h
-        st[[J[f"Elbow{s}"], J[f"Wrist{s}"], J[f"Hand{s}"]]] = INFERRED
 
 
 def _visible_chest_width(pts, centre, axis, view, H):
@@ -451,7 +370,8 @@ def _carry(prev, s, end, tip, root_pos, axis, pos, root):
 
 def _assign_sides(found, prev, prev_states, tip, lat, centre) -> dict:
     """Give each found extremity a side: feet well apart by body side (feet do not cross), otherwise by
-    continuity with the previous frame, else by body side."""
+    continuity with `prev` (the caller passes where the motion predicts the joints now), counting only
+    sides whose hand/foot was tracked, else by body side."""
     if not found:
         return {}
     if tip == "Foot" and len(found) == 2 and found[0][4] * found[1][4] < 0 \

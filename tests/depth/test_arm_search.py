@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from kinect_retarget.core.skeletons import KINECT_V1, TRACKED
-from kinect_retarget.depth import skeleton_fit
+from kinect_retarget.depth import arm_search, skeleton_fit
 from kinect_retarget.depth.arm_search import DIRECTIONS, search_arm
 from kinect_retarget.depth.tracker import SkeletonTracker
 
@@ -53,21 +53,20 @@ def test_hand_on_the_face_is_found(hand_on_face, monkeypatch):
 def test_search_alone_finds_the_arm(hand_on_face, monkeypatch):
     """With no previous pose to lean on, the depth alone places the raised arm."""
     calls = []
-    real = skeleton_fit.search_arm
+    real = arm_search.search_arm
 
     def spy(scorer, shoulder, l1, l2, lh, H, prev_elbow=None, prev_hand=None):
         calls.append((scorer, shoulder, l1, l2, lh, H))
         return real(scorer, shoulder, l1, l2, lh, H, prev_elbow, prev_hand)
 
-    monkeypatch.setattr(skeleton_fit, "search_arm", spy)
+    monkeypatch.setattr(arm_search, "search_arm", spy)
     _track(hand_on_face)
     scorer, shoulder, l1, l2, lh, H = calls[-1]     # the right arm (searched after the left) of the last frame
     g = hand_on_face.joints[-1]
     elbow, _, hand, _ = search_arm(scorer, shoulder, l1, l2, lh, H)
     assert np.linalg.norm(hand - g[HAND_R]) < 0.2 and np.linalg.norm(elbow - g[ELBOW_R]) < 0.12
     # and a pose across the chest (what the torso surface alone would allow) costs more than the found one
-    across = shoulder + np.array([-l1, 0.0, -0.1])
-    u = np.array([-1.0, 0.0, 0.0])
+    u = np.array([-1.0, 0.0, 0.0])                  # from the right shoulder toward the body's centre
     from kinect_retarget.depth.arm_search import _chain_cost
     found_cost = _chain_cost(scorer, shoulder, _unit(elbow - shoulder)[None], _unit(hand - elbow)[None], l1, l2, lh, H)[0]
     across_cost = _chain_cost(scorer, shoulder, u[None], u[None], l1, l2, lh, H)[0]
@@ -81,8 +80,7 @@ def _unit(v):
 def test_best_elbow_on_the_ik_circle_follows_the_depth(hand_on_face, monkeypatch):
     """Shoulder and wrist known (the ground truth's): of the elbows on their IK circle, the one the depth
     backs is the true one, although most of the circle lies on the body's surface too."""
-    from kinect_retarget.depth import arm_search
-    from kinect_retarget.depth.skeleton_fit import two_bone_candidates
+    from kinect_retarget.depth.two_bone import two_bone_candidates
     scorers = []
     real = arm_search.ArmScorer.__init__
 
@@ -102,7 +100,6 @@ def test_best_elbow_on_the_ik_circle_follows_the_depth(hand_on_face, monkeypatch
 
 def test_the_head_is_not_arm_evidence(hand_on_face, monkeypatch):
     """Cells around the head along the surface are the head's, not an arm's, unless in front of the face."""
-    from kinect_retarget.depth import arm_search
     calls = []
     real = arm_search.arm_evidence
 
@@ -111,7 +108,7 @@ def test_the_head_is_not_arm_evidence(hand_on_face, monkeypatch):
         calls.append((xyz, mask, pos, ev, head_region))
         return ev
 
-    monkeypatch.setattr(skeleton_fit, "arm_evidence", spy)
+    monkeypatch.setattr(arm_search, "arm_evidence", spy)
     _track(hand_on_face)
     xyz, mask, pos, ev, head_region = calls[-1]
     assert head_region is not None and head_region.sum() > 10

@@ -1,12 +1,12 @@
 """Where a limb's visible surface ends is not always where the limb ends: the image's edge (tested in
-test_tracker) and a nearer body part hiding the rest of it (depth/skeleton_fit._occluded_end)."""
+test_tracker) and a nearer body part hiding the rest of it (depth/limb_ends.py)."""
 from __future__ import annotations
 
 import numpy as np
 
 from kinect_retarget.core.skeletons import KINECT_V1
 from kinect_retarget.depth.segmentation import DepthGrid
-from kinect_retarget.depth.skeleton_fit import _occluded_end
+from kinect_retarget.depth.limb_ends import occluded_end as _occluded_end
 
 
 def _person(seq, camera, i=0):
