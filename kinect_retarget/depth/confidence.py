@@ -31,6 +31,7 @@ PREDICTION_SLACK[TORSO + SIDE_TORSO] = 0.10
 VELOCITY_DAMPING = 0.5   # a fraction of the last frame's velocity is carried on (prediction, not extrapolation)
 MIN_EXTREMITIES = 3      # of head, hands and feet; fewer and the labelling of what was found is a guess
 EDGE_ON_DEMOTES = True   # side-on, the sides overlap in depth: limbs and shoulder/hip lines are guesses
+WARMUP_FRAMES = 6        # frames after (re)acquisition during which limbs are reported inferred (0.2 s)
 RECOVERY_FRAMES = 1      # frames a joint stays flagged after its checks pass again
 LIMB_DEPTH_INSIDE = np.array([bm.DEPTH_INSIDE[KINECT_V1.joints[j].replace("Left", "").replace("Right", "")]
                               for j in LIMB])
@@ -46,6 +47,7 @@ class ConfidenceCheck:
     def reset(self) -> None:
         self._history: list[np.ndarray] = []
         self._flag_age = np.full(20, RECOVERY_FRAMES + 1)
+        self._frames = 0
 
     def predict(self) -> np.ndarray | None:
         if not self._history:
@@ -75,6 +77,9 @@ class ConfidenceCheck:
         for chain in CHAINS:   # beyond a doubtful joint the chain hangs on a guess
             bad = np.cumsum(doubt[chain]) > 0   # (an elbow the fit merely inferred leaves the hand its own evidence)
             doubt[chain] |= bad & (st[chain] == TRACKED)
+        self._frames += 1
+        if self._frames <= WARMUP_FRAMES:   # a person just found: limbs settle over the first frames
+            doubt[LIMB] = True
         self._flag_age = np.where(doubt, 0, self._flag_age + 1)
         st[(self._flag_age <= RECOVERY_FRAMES) & (st == TRACKED)] = INFERRED
         return st

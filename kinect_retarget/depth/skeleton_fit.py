@@ -42,6 +42,8 @@ OCCLUDED_ENDS = True        # an extremity beside a nearer surface is where the 
 W_MIDLINE = 1.0             # per metre a knee lies across the body's midline
 PREDICTED_SIDES = True      # left/right continuity against the motion's prediction, not the last position
 BEHIND_FREE, BEHIND_COST = 0.06, 0.5   # m behind the surface a joint may sit for free; cost per metre beyond
+SUPPORT_BEHIND = 0.08       # m behind the surface seen at its pixel an elbow/knee may sit and still be tracked
+TURNED_DEG = 45.0           # facing estimate turned this far: shoulders and hips overlap in depth, inferred
 REACH_SLACK = 0.10          # m an extremity may lie beyond the limb's calibrated reach and still be its end
 
 
@@ -93,7 +95,9 @@ class Projector:
         return np.where(on, np.where(dz < -0.04, -dz, behind), 0.25)
 
     def supported(self, p: np.ndarray, inside: float) -> bool:
-        return bool(self.cost(p[None], inside)[0] < 0.05)
+        """On the person, and at the surface seen there (not in front of it, not hidden well behind it)."""
+        dz, on = self.depth_offset(p[None], inside)
+        return bool(on[0] and -0.04 <= dz[0] <= SUPPORT_BEHIND)
 
 
 def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_states: np.ndarray | None,
@@ -303,10 +307,10 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     if ARM_SEARCH:
         fit_arms(pos, st, xyz, mask, proj, TorsoFrame(centre, axis, lat, facing, pos, H), H, prev, head_region)
     # without the head top or the shoulders the torso's place along its axis is a guess; seen more than
-    # 45 degrees from the front, shoulders and hips overlap in depth: say so instead of claiming them
+    # TURNED_DEG from the front, shoulders and hips overlap in depth: say so instead of claiming them
     if shift is None:
         st[[J["HipCenter"], J["Spine"], J["ShoulderCenter"]]] = INFERRED
-    if facing @ -view < 0.7:
+    if facing @ -view < np.cos(np.radians(TURNED_DEG)):
         for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
             st[J[name]] = INFERRED
     return FitResult(pos, st, lat, labels, centre, None if head is None else head[1], proj, edge_on or narrow)

@@ -6,7 +6,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from kinect_retarget.core.skeletons import INFERRED, KINECT_V1, TRACKED
-from kinect_retarget.depth.confidence import RECOVERY_FRAMES, ConfidenceCheck
+from kinect_retarget.depth.confidence import LIMB, RECOVERY_FRAMES, WARMUP_FRAMES, ConfidenceCheck
 from kinect_retarget.depth.evaluation import score
 from kinect_retarget.depth.tracker import track_depth_frames
 
@@ -22,6 +22,9 @@ def _steady(rng):
     pose = rng.normal(0.0, 0.3, (20, 3)) + [0.0, 0.0, 2.5]
     chk = ConfidenceCheck()
     tracked = np.full(20, TRACKED, np.uint8)
+    for _ in range(WARMUP_FRAMES + RECOVERY_FRAMES):   # a person just found: limbs settle first
+        chk.assess(pose, tracked, _fit())
+        chk.remember(pose)
     for _ in range(3):
         assert np.all(chk.assess(pose, tracked, _fit()) == TRACKED)
         chk.remember(pose)
@@ -41,6 +44,21 @@ def test_a_joint_that_breaks_the_motion_is_inferred_then_recovers(rng):
         chk.remember(pose)
         assert st[J("ElbowLeft")] == INFERRED
     assert np.all(chk.assess(pose, tracked, _fit()) == TRACKED)
+
+
+def test_limbs_settle_before_they_are_claimed(rng):
+    pose = rng.normal(0.0, 0.3, (20, 3)) + [0.0, 0.0, 2.5]
+    chk, tracked = ConfidenceCheck(), np.full(20, TRACKED, np.uint8)
+    for _ in range(WARMUP_FRAMES):
+        st = chk.assess(pose, tracked, _fit())
+        chk.remember(pose)
+        assert np.all(st[LIMB] == INFERRED) and st[J("Head")] == TRACKED and st[J("HipCenter")] == TRACKED
+    for _ in range(RECOVERY_FRAMES):
+        chk.assess(pose, tracked, _fit())
+        chk.remember(pose)
+    assert np.all(chk.assess(pose, tracked, _fit()) == TRACKED)
+    chk.reset()                                       # the person lost and found again: settle again
+    assert np.all(chk.assess(pose, tracked, _fit())[LIMB] == INFERRED)
 
 
 def test_checks_never_promote_a_joint(rng):
