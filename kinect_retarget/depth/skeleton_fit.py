@@ -227,6 +227,7 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     # --- limbs ---------------------------------------------------------------------------------------
     limb_specs = (("Shoulder", "Elbow", "Wrist", "Hand", bm.UPPER_ARM, bm.FOREARM, hands, 0.08, 0.08 + bm.HAND * H),
                   ("Hip", "Knee", "Ankle", "Foot", bm.THIGH, bm.SHIN, feet, 0.07, 0.15))
+    legs_clipped = 0
     for root, mid, end, tip, r1, r2, found, d_tip, d_end in limb_specs:
         assign = _assign_sides(found, prev if predicted is None or not PREDICTED_SIDES else predicted, prev_states,
                                tip, lat, centre)
@@ -263,8 +264,9 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
                 end_p = (tip_p if end_p is None else end_p + inside(end))
                 mid_ls = level_set_centroid(xyz, de, d_end + l2, band(0.06), end_p, l2 + 0.1)
                 labels.append((f"{tip}{s}", e[1]))
-                truncated = at_image_border(grid, (r0 + e[0][0] * k, c0 + e[0][1] * k)) \
-                    or (OCCLUDED_ENDS and occluded_end(xyz, mask, e[0]))
+                clipped = at_image_border(grid, (r0 + e[0][0] * k, c0 + e[0][1] * k))
+                legs_clipped += int(clipped and root == "Hip")
+                truncated = clipped or (OCCLUDED_ENDS and occluded_end(xyz, mask, e[0]))
                 if truncated:  # the limb leaves the image or goes behind the body: its extremity is where the
                     # view ends, not where the limb does
                     reach_left = max(0.0, l1 + l2 - np.linalg.norm(end_p - a))
@@ -310,6 +312,8 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     # TURNED_DEG from the front, shoulders and hips overlap in depth: say so instead of claiming them
     if shift is None:
         st[[J["HipCenter"], J["Spine"], J["ShoulderCenter"]]] = INFERRED
+    if legs_clipped == 2:   # both legs leave the image (the SDK's "clipped bottom"): nothing checks the hips
+        st[[J["HipCenter"], J["HipLeft"], J["HipRight"]]] = INFERRED
     if facing @ -view < np.cos(np.radians(TURNED_DEG)):
         for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
             st[J[name]] = INFERRED

@@ -61,7 +61,8 @@ def test_bad_frame_in_the_middle_then_recovery(rendered):
 def test_feet_out_of_the_image_are_not_claimed(rendered, camera):
     """The performer's shins end at the image's bottom edge (the frames moved down so the feet leave the
     view, as when someone steps close): what the surface ends on there is not a foot, so the feet and ankles
-    are reported inferred, and placed below the edge rather than on it."""
+    are reported inferred, and placed below the edge rather than on it; with both legs clipped the hips are
+    inferred too (the SDK's "clipped bottom")."""
     seq, _ = rendered
     from kinect_retarget.core.skeletons import KINECT_V1
     foot, ankle = [KINECT_V1.index(f"Foot{s}") for s in ("Left", "Right")], \
@@ -76,5 +77,7 @@ def test_feet_out_of_the_image_are_not_claimed(rendered, camera):
         moved[shift:] = seq.mm[i][:-shift]
         pos, st = tracker.update(moved, seq.times[i])
         assert np.all(st[foot + ankle] != TRACKED), f"frame {i}: a foot claimed at the image's edge"
+        hips = [KINECT_V1.index(n) for n in ("HipCenter", "HipLeft", "HipRight")]
+        assert np.all(st[hips] != TRACKED)                  # both legs clipped: nothing below checks the hips
         rows = camera.cy - camera.f * pos[foot, 1] / pos[foot, 2]
         assert np.all(rows > 480 - 8)                      # continued past the edge, not stopped on it
