@@ -1,5 +1,6 @@
-"""Arms without a hand extremity (hanging against the body, a hand on the face, folded over the chest),
-found by searching arm poses against the depth image (analysis by synthesis).
+"""Arms fitted against the depth image (analysis by synthesis): the whole arm when its hand is no tracked
+extremity (hanging against the body, a hand on the face, folded over the chest), and the elbow of a tracked
+hand on its IK circle.
 
 A candidate is the chain shoulder -> elbow -> wrist -> hand with the calibrated bone lengths. Points along
 its bones are projected into the person's depth grid, and each scores
@@ -99,8 +100,8 @@ class TorsoFrame:
 
 def arm_evidence(xyz: np.ndarray, mask: np.ndarray, pos: np.ndarray, frame: TorsoFrame,
                  head_region: np.ndarray | None = None) -> np.ndarray:
-    """Cells of the person that the torso, head and fitted legs leave unexplained. `head_region`: the
-    cells near the head along the surface, when the head was found (else a box above the shoulders)."""
+    """Cells of the person that the torso, head and fitted legs leave unexplained. The head is a box above
+    the shoulders, plus `head_region` (the cells near the head along the surface) when the head was found."""
     ev = mask & ~frame.torso(xyz, mask)
     a, l, f = frame.coords(xyz)
     face = (pos[J["Head"]] - frame.centre) @ frame.facing + 0.10   # the head joint sits 10 cm behind the face
@@ -108,17 +109,17 @@ def arm_evidence(xyz: np.ndarray, mask: np.ndarray, pos: np.ndarray, frame: Tors
     if head_region is not None:
         head |= head_region
     ev &= ~(head & (f < face + IN_FRONT))   # a hand held in front of the face still counts
-    for s in ("Left", "Right"):
-        for a, b in (("Hip", "Knee"), ("Knee", "Ankle"), ("Ankle", "Foot")):
-            ev &= _segment_distance(xyz, pos[J[f"{a}{s}"]], pos[J[f"{b}{s}"]]) > LEG_RADIUS
+    for s in SIDES:
+        for top, bottom in (("Hip", "Knee"), ("Knee", "Ankle"), ("Ankle", "Foot")):
+            ev &= _segment_distance(xyz, pos[J[f"{top}{s}"]], pos[J[f"{bottom}{s}"]]) > LEG_RADIUS
     return ev
 
 
 def near_arm(xyz: np.ndarray, pos: np.ndarray, side: str, radius: float = ARM_RADIUS) -> np.ndarray:
     """Cells within `radius` of one arm's bones (shoulder to hand)."""
     near = np.zeros(xyz.shape[:-1], bool)
-    for a, b in (("Shoulder", "Elbow"), ("Elbow", "Wrist"), ("Wrist", "Hand")):
-        near |= _segment_distance(xyz, pos[J[f"{a}{side}"]], pos[J[f"{b}{side}"]]) < radius
+    for top, bottom in (("Shoulder", "Elbow"), ("Elbow", "Wrist"), ("Wrist", "Hand")):
+        near |= _segment_distance(xyz, pos[J[f"{top}{side}"]], pos[J[f"{bottom}{side}"]]) < radius
     return near
 
 
