@@ -77,6 +77,15 @@ def triangulate(polygons: list[list[int]]) -> np.ndarray:
     return np.concatenate(out) if out else np.zeros((0, 3), np.int64)
 
 
+def _read_bytes(path: Path, limit: int = -1) -> bytes:
+    """The file's bytes (the first `limit` only when given), or a MeshError naming it."""
+    try:
+        with open(path, "rb") as fh:
+            return fh.read(limit)
+    except OSError as e:
+        raise MeshError(f"{path}: cannot read: {e.strerror or e}") from None
+
+
 def load_obj(path: str | Path, group: str | None = None) -> Mesh:
     """Read an OBJ. With `group`, keep only the faces of that `g`/`o` group (e.g. MakeHuman's 'body')."""
     path = Path(path)
@@ -84,10 +93,7 @@ def load_obj(path: str | Path, group: str | None = None) -> Mesh:
     polys: list[list[int]] = []
     poly_group: list[str] = []
     current = ""
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace")
-    except OSError as e:
-        raise MeshError(f"{path}: cannot read: {e.strerror or e}") from None
+    text = _read_bytes(path).decode("utf-8", errors="replace")
     for lineno, line in enumerate(text.splitlines(), 1):
         if line.startswith("v "):
             parts = line.split()
@@ -136,10 +142,7 @@ _PLY_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short":
 def load_ply(path: str | Path) -> Mesh:
     """Read a PLY (ascii, binary_little_endian, binary_big_endian): vertex x y z and face vertex lists."""
     path = Path(path)
-    try:
-        data = path.read_bytes()
-    except OSError as e:
-        raise MeshError(f"{path}: cannot read: {e.strerror or e}") from None
+    data = _read_bytes(path)
     end = data.find(b"end_header")
     if not data.startswith(b"ply") or end < 0:
         raise MeshError(f"{path}: not a PLY file (no 'ply' magic or no end_header)")
@@ -210,10 +213,7 @@ def load_ply(path: str | Path) -> Mesh:
 def load_glb(path: str | Path) -> Mesh:
     """Read the triangle primitives of every mesh in a binary glTF, with node transforms applied."""
     path = Path(path)
-    try:
-        data = path.read_bytes()
-    except OSError as e:
-        raise MeshError(f"{path}: cannot read: {e.strerror or e}") from None
+    data = _read_bytes(path)
     if len(data) < 20 or data[:4] != b"glTF":
         raise MeshError(f"{path}: not a binary glTF (.glb) file")
     _, _, total = struct.unpack_from("<4sII", data, 0)
@@ -282,11 +282,7 @@ def load_glb(path: str | Path) -> Mesh:
 def load_mesh(path: str | Path, group: str | None = None) -> Mesh:
     """Read OBJ, PLY or GLB, chosen from the file's content (not only its extension)."""
     path = Path(path)
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(4096)
-    except OSError as e:
-        raise MeshError(f"{path}: cannot read: {e.strerror or e}") from None
+    head = _read_bytes(path, 4096)
     if head.startswith(b"glTF"):
         return load_glb(path)
     if head.startswith(b"ply"):

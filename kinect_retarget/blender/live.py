@@ -495,8 +495,10 @@ def _blender_message(exc: Exception) -> str:
 
 
 # -- operators -----------------------------------------------------------------------------------------------
-def _flush_reports(op) -> None:
-    c = _controller
+def _flush_reports(op, controller=None) -> None:
+    """Pass a controller's queued reports to the operator (default: the running one; a stopped one's last
+    words are passed explicitly)."""
+    c = controller if controller is not None else _controller
     for level, msg in (c.reports if c else []):
         op.report({level}, msg)
     if c:
@@ -547,8 +549,7 @@ class KINECT_RETARGET_OT_live_start(bpy.types.Operator):
             _flush_reports(self)
             stop_live(context=context)
         if _controller is not self._ctrl or self._ctrl is None:
-            for level, msg in (self._ctrl.reports if self._ctrl else []):
-                self.report({level}, msg)
+            _flush_reports(self, self._ctrl)
             context.window_manager.event_timer_remove(self._timer)
             return {"CANCELLED"} if self._ctrl and self._ctrl.session.error else {"FINISHED"}
         if event.type == "TIMER":
@@ -569,9 +570,7 @@ class KINECT_RETARGET_OT_live_stop(bpy.types.Operator):
     def execute(self, context):
         c = _controller
         stop_live(context=context)
-        for level, msg in c.reports:
-            self.report({level}, msg)
-        c.reports.clear()
+        _flush_reports(self, c)
         return {"FINISHED"}
 
 
