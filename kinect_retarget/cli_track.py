@@ -12,8 +12,8 @@ import sys
 import numpy as np
 
 from .core.take import TakeError
+from .device.protocol import TIMESTAMP_HZ, TIMESTAMP_WRAP
 
-TICKS_PER_SECOND = 60_000_000
 
 
 def add_parser(subparsers) -> None:
@@ -33,8 +33,8 @@ def _times_from(data, n: int, path: str) -> np.ndarray:
     elif "timestamp" in data:
         ticks = np.asarray(data["timestamp"], dtype=np.int64)
         # device ticks wrap at 2**32: unwrap before converting
-        steps = np.diff(ticks) % (1 << 32)
-        t = np.concatenate([[0.0], np.cumsum(steps)]) / TICKS_PER_SECOND
+        steps = np.diff(ticks) % TIMESTAMP_WRAP
+        t = np.concatenate([[0.0], np.cumsum(steps)]) / TIMESTAMP_HZ
     else:
         t = np.arange(n) / 30.0
     if t.shape != (n,):

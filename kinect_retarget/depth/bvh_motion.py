@@ -92,7 +92,6 @@ def read_bvh_positions(path: str | os.PathLike, unit: float = CMU_UNIT_M):
             v = data[:, col]
             col += 1
             if c.endswith("position"):
-                trans["XYZ".index(c[0])] if False else None
                 trans[:, "XYZ".index(c[0])] = v * unit
             else:
                 rot = rot @ _axis_rot(c[0], np.radians(v))

@@ -13,7 +13,6 @@ import numpy as np
 from ..device.calibration import Calibration
 
 DEFAULT_CALIBRATION = Calibration()
-NO_READING_RAW = 2047
 WIDTH, HEIGHT = 640, 480
 
 
@@ -24,13 +23,7 @@ class DepthCamera:
     cy: float = 239.5
     width: int = WIDTH
     height: int = HEIGHT
-    baseline: float = 0.075   # IR projector to IR camera, metres
     projector_x: float = -0.075  # projector position along Kinect X (it sits on the sensor's right)
-
-
-def raw_to_metres(raw: np.ndarray, calibration: Calibration = DEFAULT_CALIBRATION) -> np.ndarray:
-    """Depth in metres for raw 11-bit values (0 where there is no reading), the driver's formula."""
-    return calibration.raw_to_mm_table()[np.minimum(np.asarray(raw, dtype=np.int64), NO_READING_RAW)] * 0.001
 
 
 def metres_to_raw(z: np.ndarray, calibration: Calibration = DEFAULT_CALIBRATION) -> np.ndarray:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.conventions import kinect_to_depth_pixel
 from ..core.skeletons import KINECT_V1, NOT_TRACKED, TRACKED
 from .camera import DepthCamera
 
@@ -32,8 +33,7 @@ def preview_rgba(depth_mm: np.ndarray, person_mask: np.ndarray | None, positions
     pos, st = np.asarray(positions, dtype=np.float64), np.asarray(states)
     ok = (st != NOT_TRACKED) & np.all(np.isfinite(pos), axis=1) & (pos[:, 2] > 0.1)
     uv = np.zeros((len(pos), 2))
-    uv[ok, 0] = (cam.cx - cam.f * pos[ok, 0] / pos[ok, 2]) / scale
-    uv[ok, 1] = (cam.cy - cam.f * pos[ok, 1] / pos[ok, 2]) / scale
+    uv[ok] = kinect_to_depth_pixel(pos[ok], cam.f, cam.cx, cam.cy) / scale
     t = np.linspace(0.0, 1.0, 24)[:, None]
     for j, p in enumerate(KINECT_V1.parents):
         if p < 0 or not (ok[j] and ok[p]):

@@ -16,10 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from ..core.skeletons import KINECT_V1
+from ..device.protocol import TIMESTAMP_HZ, TIMESTAMP_WRAP
 from .tracker import SkeletonTracker
-
-TICKS_PER_SECOND = 60_000_000
-TICK_WRAP = 1 << 32
 
 
 class DepthSkeletonProducer:
@@ -30,9 +28,8 @@ class DepthSkeletonProducer:
         self.stream = stream
         self.tracker = tracker or SkeletonTracker()
         self._own = own_stream
-        self._first_tick: int | None = None
         self._elapsed = 0
-        self._last_tick = 0
+        self._last_tick: int | None = None   # None until the first frame
         self._lock = threading.Lock()
         self._preview = None
 
@@ -41,11 +38,11 @@ class DepthSkeletonProducer:
             frame = self.stream.frames.get(timeout=timeout)
         except queue.Empty:
             return None
-        if self._first_tick is None:
-            self._first_tick = self._last_tick = frame.timestamp
-        self._elapsed += (frame.timestamp - self._last_tick) % TICK_WRAP   # the device clock wraps at 2**32
+        if self._last_tick is None:
+            self._last_tick = frame.timestamp
+        self._elapsed += (frame.timestamp - self._last_tick) % TIMESTAMP_WRAP   # the device clock wraps
         self._last_tick = frame.timestamp
-        t = self._elapsed / TICKS_PER_SECOND
+        t = self._elapsed / TIMESTAMP_HZ
         mm = frame.mm if frame.mm is not None else frame.calibration.to_mm(frame.raw)
         positions, states = self.tracker.update(mm, t)
         with self._lock:
@@ -71,7 +68,7 @@ class DepthSkeletonProducer:
 def simulated_frames(frames: int = 90, clip: str = "131_03", shared_data: str | None = None) -> list[np.ndarray]:
     """Raw 11-bit frames of a rendered real motion for the emulated Kinect, cached on disk (rendering
     takes about half a second per frame the first time)."""
-    from .synthetic import Scenario, render_sequence
+    from .synthetic import Scenario, default_mesh_dir, render_sequence
     data = Path(shared_data) if shared_data else Path(__file__).resolve().parents[3] / "shared" / "data"
     cache = Path(os.environ.get("KR_DEPTH_CACHE", Path(tempfile.gettempdir()) / "kinect_retarget_depth_cache"))
     cache.mkdir(parents=True, exist_ok=True)
@@ -81,7 +78,7 @@ def simulated_frames(frames: int = 90, clip: str = "131_03", shared_data: str | 
     bvh = data / "mocap_bvh" / f"{clip}.bvh"
     if not bvh.exists():
         raise FileNotFoundError(f"{bvh}: the simulated Kinect renders CMU mocap from the shared data folder")
-    seq = render_sequence(str(bvh), str(data / "meshes" / "makehuman"), Scenario(seed=11), frames=frames)
+    seq = render_sequence(str(bvh), default_mesh_dir(str(data)), Scenario(seed=11), frames=frames)
     np.save(path, seq.raw)
     return list(seq.raw)
 

@@ -11,7 +11,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .camera import NO_READING_RAW, DepthCamera, metres_to_raw
+from ..core.conventions import kinect_to_depth_pixel
+from ..device.depth_unpack import NO_READING_RAW
+from .camera import DepthCamera, metres_to_raw
 
 
 @dataclass
@@ -42,8 +44,7 @@ def splat(points: np.ndarray, cam: DepthCamera) -> np.ndarray:
     ok = z > 0.3
     p = points[ok]
     z = z[ok]
-    u = np.round(cam.cx - cam.f * p[:, 0] / z).astype(np.int64)
-    v = np.round(cam.cy - cam.f * p[:, 1] / z).astype(np.int64)
+    u, v = np.round(kinect_to_depth_pixel(p, cam.f, cam.cx, cam.cy)).astype(np.int64).T
     inside = (u >= 0) & (u < cam.width) & (v >= 0) & (v < cam.height)
     idx, z = v[inside] * cam.width + u[inside], z[inside]
     order = np.argsort(-z, kind="stable")  # nearest written last wins
@@ -81,8 +82,8 @@ def room_depth(room: Room, cam: DepthCamera, tilt_deg: float = 0.0) -> np.ndarra
         tw = room.back_wall_z / dw[..., 2]
         t = np.minimum(t, np.where(dw[..., 2] > 0, tw, np.inf))
         for lo, hi in room.boxes:
-            t1 = (np.asarray(lo) - 0) / dw
-            t2 = (np.asarray(hi) - 0) / dw
+            t1 = np.asarray(lo) / dw   # the rays start at the sensor's origin
+            t2 = np.asarray(hi) / dw
             tmin = np.max(np.minimum(t1, t2), axis=-1)
             tmax = np.min(np.maximum(t1, t2), axis=-1)
             t = np.where((tmax >= tmin) & (tmin > 0), np.minimum(t, tmin), t)

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.conventions import kinect_to_depth_pixel
 from .camera import DepthCamera
 
 MIN_Z, MAX_Z = 0.5, 4.5
@@ -38,9 +39,8 @@ class DepthGrid:
     def to_pixel(self, points: np.ndarray) -> np.ndarray:
         """(..., 3) Kinect points -> (..., 2) float grid coordinates (row, col)."""
         c = self.camera
-        z = np.maximum(points[..., 2], 1e-6)
-        u = c.cx - c.f * points[..., 0] / z
-        v = c.cy - c.f * points[..., 1] / z
+        p = np.concatenate([points[..., :2], np.maximum(points[..., 2:3], 1e-6)], axis=-1)   # never divide by 0
+        u, v = np.moveaxis(kinect_to_depth_pixel(p, c.f, c.cx, c.cy), -1, 0)
         return np.stack([(v - self.step // 2) / self.step, (u - self.step // 2) / self.step], axis=-1)
 
 

@@ -11,6 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.conventions import kinect_to_depth_pixel
+from ..device.protocol import TIMESTAMP_HZ
 from .body_model import load_body
 from .bvh_motion import read_bvh_positions
 from .camera import DepthCamera, raw_to_mm
@@ -18,7 +20,6 @@ from .mocap_pose import cmu_points, pose_from_points
 from .render import (Room, fill_pinholes, gravity_in_camera, kinect_artifacts, quad_sampler, room_depth, splat,
                      surface_points, _tilt)
 
-TICKS_PER_SECOND = 60_000_000  # the device's timestamp clock
 
 
 @dataclass
@@ -53,6 +54,7 @@ class SyntheticSequence:
 
 
 def default_mesh_dir(shared_data: str) -> str:
+    """The MakeHuman base mesh folder inside the shared data folder."""
     return os.path.join(shared_data, "meshes", "makehuman")
 
 
@@ -120,7 +122,7 @@ def render_sequence(bvh_path: str, mesh_dir: str, scenario: Scenario | None = No
         depth = np.minimum(depth, background)
         raw[i] = kinect_artifacts(depth, cam, rng, noise_raw=sc.noise_raw)
     times = np.arange(nf) / fps
-    uv_x = cam.cx - cam.f * joints[..., 0] / joints[..., 2]
+    uv_x = kinect_to_depth_pixel(joints, cam.f, cam.cx, cam.cy)[..., 0]
     present = np.any((uv_x > 0) & (uv_x < cam.width), axis=1)
-    return SyntheticSequence(raw, raw_to_mm(raw), (times * TICKS_PER_SECOND).astype(np.int64), times,
+    return SyntheticSequence(raw, raw_to_mm(raw), (times * TIMESTAMP_HZ).astype(np.int64), times,
                              gravity_in_camera(sc.tilt_deg), joints, present, cam)

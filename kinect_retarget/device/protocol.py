@@ -143,6 +143,7 @@ DEPTH_PAYLOAD = 1748                   # per packet, 1760 with the header
 DEPTH_PACKETS_PER_FRAME = -(-DEPTH_FRAME_BYTES // DEPTH_PAYLOAD)   # 242
 DEPTH_LAST_PAYLOAD = DEPTH_FRAME_BYTES - DEPTH_PAYLOAD * (DEPTH_PACKETS_PER_FRAME - 1)   # 1132
 TIMESTAMP_HZ = 60_000_000
+TIMESTAMP_WRAP = 1 << 32   # the frame timestamp is a 32-bit counter
 TICKS_PER_FRAME = TIMESTAMP_HZ // 30
 _PACKET = struct.Struct("<2sBBBB")     # magic, pad, flag, unknown, seq; then length (BE) and timestamp (LE)
 
