@@ -16,7 +16,6 @@ import numpy as np
 KINECT_TO_BLENDER = np.array([[-1.0, 0.0, 0.0],
                               [0.0, 0.0, 1.0],
                               [0.0, 1.0, 0.0]])
-BLENDER_TO_KINECT = KINECT_TO_BLENDER.T
 
 
 def kinect_to_blender(points: np.ndarray) -> np.ndarray:

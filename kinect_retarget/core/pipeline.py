@@ -69,7 +69,7 @@ class RetargetPipeline:
         self.settings = settings or RetargetSettings()
         self.retargeter = Retargeter(skeleton, rig, mapping, root_mode=self.settings.root_mode,
                                      root_scale=self.settings.root_scale)
-        self.source_leg: float | None = None  # set by calibrate(); process_take measures it when unset
+        self.source_leg: float | None = None  # set by live calibration; process_take measures it when unset
         self.reset()
 
     @property
@@ -110,12 +110,6 @@ class RetargetPipeline:
         unseen = np.array([unknown[m.head] or unknown[m.tail] for m in self.retargeter.mapped])
         root = self.skeleton.root
         return np.where(np.isfinite(out), out, out[:, root:root + 1]), unseen
-
-    def calibrate(self, positions: np.ndarray) -> float | None:
-        """Fix the source leg length (root scale n) from (F, J, 3) frames of the performer standing."""
-        p = self._mirrored(np.asarray(positions, dtype=np.float64))
-        self.source_leg = leg_length(resolver(self.skeleton.joints, p))
-        return self.source_leg
 
     def _mirrored(self, positions: np.ndarray) -> np.ndarray:
         return mirror_positions(positions, self.skeleton.mirror) if self.settings.mirror else positions

@@ -110,15 +110,3 @@ def angle_between(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
 def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Rotate (..., 3) vectors by (..., 4) quaternions."""
     return np.einsum("...ij,...j->...i", to_matrix(q), v)
-
-
-def matrix_from_two_vectors(primary: np.ndarray, secondary: np.ndarray) -> np.ndarray:
-    """Orthonormal frames (..., 3, 3) whose columns are X, Y, Z with Y along `primary`.
-
-    Improved D-H construction of paper 000 (§2.3): X = Y × AB, Z = X × Y, with AB = `secondary`.
-    Callers keep `secondary` away from parallel to `primary` (see joint_frames).
-    """
-    y = normalize(primary)
-    x = normalize(np.cross(y, secondary))
-    z = np.cross(x, y)
-    return np.stack([x, y, z], axis=-1)
