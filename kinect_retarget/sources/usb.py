@@ -1,8 +1,8 @@
 """The USB Kinect as a frame source: wraps whatever skeleton-frame producer exists.
 
 A producer is any object with `read(timeout) -> (positions (J,3), states (J,), time_s) | None` (None: no
-skeleton this time), `skeleton` and optionally `rate` and `close()`. The depth-to-skeleton tracker is its own
-piece of work; until one is importable, this source refuses to start with a sentence that says so.
+skeleton this time), `skeleton` and optionally `rate` and `close()`. The producer is the depth-to-skeleton tracker's
+(`depth.producer`); when it cannot be imported, this source refuses to start with a sentence that says so.
 """
 from __future__ import annotations
 
@@ -11,9 +11,9 @@ import time
 
 from .base import FrameSource, SourceError
 
-# Where a tracker may provide `open_skeleton_producer()`; first importable one wins. Relative to the package,
+# Where a tracker provides `open_skeleton_producer()`; first importable one wins. Relative to the package,
 # which is `bl_ext.<repo>.kinect_retarget` when installed as an extension.
-PRODUCER_MODULES = (".depth.producer", ".tracking", ".device.skeleton")
+PRODUCER_MODULES = (".depth.producer",)
 _ROOT = __package__.rpartition(".")[0]
 
 
