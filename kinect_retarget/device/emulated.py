@@ -83,7 +83,6 @@ class EmulatedKinect(usb.backend.IBackend):
         self._bulk_replies: list[bytes] = []
         self._assign_addresses()
         self._power_on()
-        self.depth_starts = 0                   # how many times the depth stream was started
         self.streams: list[DepthPacketizer] = []
         self.register_log: list[tuple[int, int, bool]] = []   # (reg, value, iso transfers were queued)
 
@@ -313,7 +312,6 @@ class EmulatedKinect(usb.backend.IBackend):
             packetizer = DepthPacketizer(self.images, seq0, sid * 12_345_678, packed=self._packed)
             self.depth_stream = _DepthStreamState(sid, now, packetizer)
             self.streams.append(packetizer)
-            self.depth_starts += 1
 
     def _motor_control(self, rtype, request, value, data) -> int:
         try:

@@ -45,10 +45,6 @@ class DepthPacketizer:
         self.first_seq = first_seq
         self.first_timestamp = first_timestamp
 
-    @property
-    def n_images(self) -> int:
-        return len(self._packed)
-
     def timestamp(self, frame: int) -> int:
         return (self.first_timestamp + frame * TICKS_PER_FRAME) & 0xFFFFFFFF
 

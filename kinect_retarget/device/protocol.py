@@ -105,10 +105,6 @@ def words(*values: int) -> bytes:
     return struct.pack(f"<{len(values)}H", *values)
 
 
-def read_register_command(reg: int, tag: int) -> bytes:
-    return build_command(OP_READ_REGISTER, tag, words(reg))
-
-
 def write_register_command(reg: int, value: int, tag: int) -> bytes:
     return build_command(OP_WRITE_REGISTER, tag, words(reg, value))
 

@@ -42,7 +42,6 @@ class AssemblyStats:
     frames_dropped: int = 0    # started but not delivered
     frames_missed: int = 0     # gaps between delivered frames' timestamps: every frame not delivered
     resyncs: int = 0
-    extra: dict = field(default_factory=dict)
 
 
 class FrameAssembler:
@@ -61,12 +60,6 @@ class FrameAssembler:
         self._anchor: tuple[int, int] | None = None   # (abs index, timestamp) of the last start-of-frame
         self._last_delivered: int | None = None
         self._buf = bytearray()
-
-    def reset(self) -> None:
-        """Forget the frame in progress (e.g. after the stream restarted)."""
-        if self._synced and self._pkt:
-            self.stats.frames_dropped += 1
-        self._synced = False
 
     def feed(self, packets) -> list[AssembledFrame]:
         """Feed iso packets in arrival order; None marks a slot the USB stack reported as failed.
@@ -98,11 +91,10 @@ class FrameAssembler:
         start = first_packet * DEPTH_PAYLOAD
         self._holes.append((start, min(start + count * DEPTH_PAYLOAD, DEPTH_FRAME_BYTES)))
 
-    def _abandon(self, reason: str) -> None:
+    def _abandon(self) -> None:
         if self._pkt:
             self.stats.frames_dropped += 1
         self.stats.resyncs += 1
-        self.stats.extra["last_resync"] = reason
         self._synced = False
         self._pkt = 0
 
@@ -173,7 +165,7 @@ class FrameAssembler:
             gap = (seq - self._seq) & 0xFF
             left = DEPTH_PACKETS_PER_FRAME - self._pkt
             if gap > self.max_gap:
-                self._abandon(f"{gap} packets lost")
+                self._abandon()                       # too many packets lost
                 if flag == FLAG_DEPTH_SOF:
                     self._start_frame(seq)
                 elif not self._resync_without_sof(flag, seq):
@@ -195,7 +187,7 @@ class FrameAssembler:
         last = DEPTH_PACKETS_PER_FRAME - 1
         expected_flag = FLAG_DEPTH_SOF if pkt == 0 else (FLAG_DEPTH_EOF if pkt == last else FLAG_DEPTH_MOF)
         if flag != expected_flag:
-            self._abandon(f"flag {flag:#x} at packet {pkt}")
+            self._abandon()                           # the packet's flag does not fit its position
             if flag != FLAG_DEPTH_SOF:
                 return done
             self._start_frame(seq)

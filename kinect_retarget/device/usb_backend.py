@@ -83,7 +83,6 @@ class LibusbIsoPump:
         self._out: list = []
         self._stopping = False
         self._gone: str | None = None
-        self.errors = 0                          # transfers that completed with an error status
         self._prototype()
 
     def _prototype(self) -> None:
@@ -181,8 +180,7 @@ class LibusbIsoPump:
                 elif desc.actual_length:
                     out.append(ctypes.string_at(base + i * size, desc.actual_length))
         else:
-            self.errors += 1                      # whole transfer failed: its slots are lost
-            out = self._out
+            out = self._out                       # whole transfer failed: its slots are lost
             out.extend([None] * t.num_iso_packets)
         self._submit(transfer_p, key)
 
