@@ -13,6 +13,7 @@ from .core.kinect_rig_layout import typical_segment_lengths
 def add_parser(sub) -> None:
     from .core.filters import FILTERS
     from .core.presets import PRESET_NAMES
+    from .core.retarget import ROOT_MODES
 
     p = sub.add_parser("live", help="drive a rig live from a source without a window; prints JSON statistics")
     p.add_argument("--source", required=True, help="take:FILE, osc:PORT or usb")
@@ -22,7 +23,7 @@ def add_parser(sub) -> None:
     p.add_argument("--preset", default="auto", choices=PRESET_NAMES, help="bone-mapping preset (default: auto)")
     p.add_argument("--mapping", help="JSON bone-mapping overrides")
     p.add_argument("--filter", default="default", choices=FILTERS, help="jitter filter (default: default)")
-    p.add_argument("--root", default="xyz", choices=("xyz", "xy", "none"), help="root motion")
+    p.add_argument("--root", default="xyz", choices=ROOT_MODES, help="root motion")
     p.add_argument("--mirror", action="store_true", help="swap the performer's left and right")
     p.add_argument("--speed", type=float, default=1.0, help="take playback speed (take: sources)")
     p.add_argument("--loop", action="store_true", help="loop take playback")
