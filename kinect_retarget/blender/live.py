@@ -30,7 +30,7 @@ from .pose_apply import apply_frame_pose, restore_pose, snapshot_pose
 from .evaluated_solve import correct_for_evaluation
 from .preferences import get_preferences
 from .properties import ensure_defaults, target_armature
-from .rig_reader import target_rig_from_object
+from .rig_reader import constrained_bones, target_rig_from_object
 
 usb_source_factory = None  # set by the USB panel (usb_panel.py): simulated Kinect, device freed from its preview
 TIMER_INTERVAL = 1 / 120  # pump often: latency is arrival -> applied, and an empty pump costs microseconds
@@ -55,7 +55,7 @@ class LiveController:
         try:
             self._rigify_fk(obj)
             pipeline = session.pipeline
-            corrector = ConstrainedParentCorrection(pipeline.rig, pipeline.bone_names, _constrained_bones(obj)) \
+            corrector = ConstrainedParentCorrection(pipeline.rig, pipeline.bone_names, constrained_bones(obj)) \
                 if hasattr(pipeline, "rig") else None
             self.corrector = corrector if corrector is not None and corrector.active else None
             self.update_after_apply = bool(bpy.app.background)
@@ -253,15 +253,6 @@ def _unused_path(folder: str, base: str, ext: str) -> tuple[str, str]:
         n += 1
         suffix = f"_{n}"
     return os.path.join(folder, base + suffix + ext), suffix
-
-
-def _constrained_bones(obj) -> set[str]:
-    """Bones whose pose Blender computes from more than their parent: constraints or drivers."""
-    names = {pb.name for pb in obj.pose.bones if len(pb.constraints)}
-    ad = obj.animation_data
-    if ad is not None:
-        names.update(d.data_path.split('"')[1] for d in ad.drivers if d.data_path.startswith('pose.bones["'))
-    return names
 
 
 def _save_state(obj) -> dict:

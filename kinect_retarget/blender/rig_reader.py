@@ -32,21 +32,25 @@ def target_rig_from_object(obj: bpy.types.Object) -> TargetRig:
                      generated=bool(obj.get(GENERATED_TAG, False)))
 
 
+def constrained_bones(obj: bpy.types.Object) -> set[str]:
+    """Bones whose pose Blender computes from more than their parent: constraints or drivers."""
+    names = {pb.name for pb in obj.pose.bones if len(pb.constraints)}
+    ad = obj.animation_data
+    if ad is not None:
+        names.update(d.data_path.split('"')[1] for d in ad.drivers if d.data_path.startswith('pose.bones["'))
+    return names
+
+
 def has_constrained_ancestry(obj: bpy.types.Object, bone_names) -> bool:
     """True when an ancestor of a mapped bone has constraints or drivers: the mapped bone's posed parent
     matrix then depends on more than rest matrices and must be read back from Blender's evaluation. (A mapped
     bone's own constraints act after its keyed rotation, as the rig's author intended.)"""
-    driven = set()
-    ad = obj.animation_data
-    if ad is not None:
-        for drv in ad.drivers:
-            if drv.data_path.startswith('pose.bones["'):
-                driven.add(drv.data_path.split('"')[1])
+    constrained = constrained_bones(obj)
     for name in bone_names:
         pb = obj.pose.bones.get(name)
         pb = pb.parent if pb is not None else None
         while pb is not None:
-            if len(pb.constraints) or pb.name in driven:
+            if pb.name in constrained:
                 return True
             pb = pb.parent
     return False
