@@ -33,10 +33,10 @@ def looks_like(head: bytes) -> bool:
 def read(path: str | os.PathLike) -> Take:
     path = os.fspath(path)
     values, lines = parse_table(path, read_bytes(path), NCOL, delimiters=b",", what="frame line")
-    return make_take(path, values, lines, "kinect_v2_csv")
+    return make_take(path, values, lines)
 
 
-def make_take(path: str, values: np.ndarray, lines: np.ndarray, source_format: str) -> Take:
+def make_take(path: str, values: np.ndarray, lines: np.ndarray) -> Take:
     """Frames (timestamp ticks, 25 x (x, y, z, state)) -> Take; names the line of any bad value."""
     block = values[:, 1:].reshape(-1, len(KINECT_V2), 4)
     states = block[..., 3]
@@ -51,4 +51,4 @@ def make_take(path: str, values: np.ndarray, lines: np.ndarray, source_format: s
         raise TakeError(f"{path}: no joint is tracked in any frame")
     times = (ticks - ticks[0]) / TICKS_PER_SECOND
     meta = {"source_file": os.path.basename(path), "first_timestamp_ticks": int(ticks[0])}
-    return Take(KINECT_V2, block[..., :3], states, times, nominal_rate(times), source_format, meta)
+    return Take(KINECT_V2, block[..., :3], states, times, nominal_rate(times), "kinect_v2_csv", meta)
