@@ -25,7 +25,6 @@ class FeaturePoints:
     up: np.ndarray
     front: np.ndarray
     left: np.ndarray
-    extremity_ratio: float  # 6th farthest-point radius / 5th: small for a human with five limbs
 
 
 def farthest_points(graph: MeshGraph, count: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -141,7 +140,7 @@ def find_feature_points(vertices: np.ndarray, graph: MeshGraph) -> FeaturePoints
     fl, fr = split(feet)
     sel = [head, hl, hr, fl, fr]
     tips, fields = _refine_tips(graph, tips[sel], fields[sel])
-    return FeaturePoints(tips, fields, up, front, left, float(ratio))
+    return FeaturePoints(tips, fields, up, front, left)
 
 
 def _refine_tips(graph: MeshGraph, tips: np.ndarray, fields: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -114,10 +114,3 @@ def bone_projection_weights(vertices: np.ndarray, segment: np.ndarray, joints: n
     if graph is not None and len(graph.edges):
         w = smooth_over_surface(w, graph.indptr, graph.indices, smoothing_iterations(graph.lengths, height))
     return top_influences(w)
-
-
-def dense_weights(index: np.ndarray, weight: np.ndarray, bones: int) -> np.ndarray:
-    """(V, 4) sparse influences -> (V, bones) dense matrix."""
-    out = np.zeros((len(index), bones))
-    np.add.at(out, (np.repeat(np.arange(len(index)), index.shape[1]), index.ravel()), weight.ravel())
-    return out
