@@ -11,7 +11,6 @@ from .pose_apply import set_rotations
 
 MAX_PASSES = 8
 TOLERANCE = np.radians(0.05)  # residual (sin of the angle) accepted per bone
-stats = {"frames": 0, "evaluations": 0}  # of the last call, for benchmarks
 
 
 def _mapped_ancestors(pose_bones, bone_names) -> tuple[list[int], list[int]]:
@@ -46,7 +45,6 @@ def correct_for_evaluation(obj: bpy.types.Object, bone_names, quats: np.ndarray,
     out = np.array(quats, dtype=np.float64)
     plain = to_matrix(out)
     carry = np.broadcast_to(np.eye(3), plain.shape[1:]).copy()  # last frame's correction, a warm start
-    stats.update(frames=out.shape[0], evaluations=0)
     for f in range(out.shape[0]):
         if root_bone is not None:
             pose_bones[root_bone].location = root_location[f].tolist()
@@ -56,7 +54,6 @@ def correct_for_evaluation(obj: bpy.types.Object, bone_names, quats: np.ndarray,
             set_rotations(pose_bones, bone_names, from_matrix(basis))
             obj.update_tag()
             view_layer.update()
-            stats["evaluations"] += 1
             pose_bones.foreach_get("matrix", flat)
             actual = flat.reshape(nb, 4, 4).transpose(0, 2, 1)[index, :3, :3].astype(np.float64)
             actual /= np.linalg.norm(actual, axis=-2, keepdims=True)  # drop any pose scale
