@@ -76,6 +76,9 @@ class BvhMotion:
     up_axis: int = 1             # 0, 1 or 2: the lab axis pointing up
     up_sign: float = 1.0
     notes: dict = field(default_factory=dict)
+    # bvh_names.resolve's mapping: {kinect joint: BVH joint indices}, or {family: [unresolved joints]} if
+    # the family is None; None until resolved (read_bvh_skeleton resolves it)
+    mapping: dict | None = None
 
     @property
     def frame_count(self) -> int:
@@ -321,16 +324,16 @@ def read_bvh_skeleton(path: str | os.PathLike, scale: float | None = None) -> Bv
     positions, g_rot = forward_kinematics(sk, values)
     rest, _ = forward_kinematics(sk, np.zeros((1, sk.channel_count)))
     motion = BvhMotion(path, sk, frame_time, values, positions, g_rot, rest[0])
-    motion.family, mapping = _family(sk)
+    motion.family, motion.mapping = _family(sk)
     if motion.family is not None:  # unknown skeletons keep the BVH convention, Y up
-        motion.up_axis, motion.up_sign = _up_axis(rest[0], mapping)
-    motion.units_to_metres = _units(motion, mapping, scale)
+        motion.up_axis, motion.up_sign = _up_axis(rest[0], motion.mapping)
+    motion.units_to_metres = _units(motion, scale)
     return motion
 
 
 def kinect_joints_lab(motion: BvhMotion) -> np.ndarray:
     """(F, 20, 3) Kinect v1 joints in lab axes and metres, from the name tables (bvh_names.py)."""
-    family, mapping = _family(motion.skeleton)
+    family, mapping = (motion.family, motion.mapping) if motion.mapping is not None else _family(motion.skeleton)
     if family is None:
         detail = "; ".join(f"{fam}: no {', '.join(miss[:4])}{'...' if len(miss) > 4 else ''}"
                            for fam, miss in mapping.items())
@@ -362,14 +365,17 @@ class VirtualKinect:
 
 
 def virtual_kinect(motion: BvhMotion, distance: float = DEFAULT_CAMERA_DISTANCE,
-                   height: float = DEFAULT_CAMERA_HEIGHT, min_range: float | None = MIN_RANGE) -> VirtualKinect:
+                   height: float = DEFAULT_CAMERA_HEIGHT, min_range: float | None = MIN_RANGE,
+                   joints: np.ndarray | None = None) -> VirtualKinect:
     """Where the virtual sensor stands for this motion (docs/take_formats.md, BVH step 5).
 
     `distance` metres in front of the hips at frame 0 (facing = (left hip - right hip) x up), `height` metres
     above the floor (the lowest any joint goes), level. If the performer ever comes closer than `min_range`
-    metres, the sensor backs away along its viewing axis until they never do (None: stay put).
+    metres, the sensor backs away along its viewing axis until they never do (None: stay put). `joints`:
+    kinect_joints_lab(motion) if the caller already has it.
     """
-    joints = kinect_joints_lab(motion)
+    if joints is None:
+        joints = kinect_joints_lab(motion)
     up = np.zeros(3)
     up[motion.up_axis] = motion.up_sign
     floor = float(np.min(motion.positions_m @ up))
@@ -398,8 +404,9 @@ def read(path: str | os.PathLike, scale: float | None = None,
          min_range: float | None = MIN_RANGE) -> Take:
     """A BVH file as a Kinect v1 take seen by a virtual sensor in front of the performer (virtual_kinect)."""
     motion = read_bvh_skeleton(path, scale)
-    cam = virtual_kinect(motion, camera_distance, camera_height, min_range)
-    kinect = cam.to_kinect(kinect_joints_lab(motion))
+    joints = kinect_joints_lab(motion)
+    cam = virtual_kinect(motion, camera_distance, camera_height, min_range, joints)
+    kinect = cam.to_kinect(joints)
     states = np.full(kinect.shape[:2], TRACKED, dtype=np.uint8)
     times = np.arange(motion.frame_count) * motion.frame_time
     meta = {"source_file": os.path.basename(motion.path), "bvh_family": motion.family,
@@ -428,13 +435,13 @@ def _up_axis(rest: np.ndarray, mapping: dict[str, tuple[int, ...]]) -> tuple[int
     return axis, float(np.sign(d[axis]) or 1.0)
 
 
-def _units(motion: BvhMotion, mapping, scale: float | None) -> float:
+def _units(motion: BvhMotion, scale: float | None) -> float:
     if scale is not None:
         if not (np.isfinite(scale) and scale > 0):
             raise TakeError(f"{motion.path}: scale must be a positive number of metres per unit, got {scale}")
         motion.notes["units"] = "explicit"
         return float(scale)
-    if motion.family in bvh_names.FAMILY_UNITS and motion.family is not None:
+    if motion.family in bvh_names.FAMILY_UNITS:
         motion.notes["units"] = f"family {motion.family}"
         return bvh_names.FAMILY_UNITS[motion.family]
     rest = motion.rest_positions
