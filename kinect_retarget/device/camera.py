@@ -14,6 +14,7 @@ import usb.util
 from . import protocol as P
 from .calibration import Calibration, calibration_from_replies
 from .errors import AccessDenied, DeviceGone, KinectError, ProtocolError
+from .usb_backend import LIBUSB_ERROR_NO_DEVICE
 
 REPLY_TIMEOUT_S = 1.0
 USB_TIMEOUT_MS = 500
@@ -21,8 +22,8 @@ USB_TIMEOUT_MS = 500
 
 def is_gone(exc: BaseException) -> bool:
     """True when a pyusb error means the device is no longer there."""
-    return isinstance(exc, usb.core.USBError) and (exc.errno in (errno.ENODEV, errno.EIO)
-                                                   or getattr(exc, "backend_error_code", None) == -4)
+    return isinstance(exc, usb.core.USBError) and (
+        exc.errno in (errno.ENODEV, errno.EIO) or getattr(exc, "backend_error_code", None) == LIBUSB_ERROR_NO_DEVICE)
 
 
 def access_advice(exc: BaseException) -> str:

@@ -26,9 +26,9 @@ from .emulated_motor import EmulatedMotor, Rejected
 from .emulated_stream import DepthPacketizer, EmulatedIsoPump, Faults, VirtualClock
 from .emulated_usb import UsbFunction, build_functions
 from .protocol import TICKS_PER_FRAME
+from .usb_backend import LIBUSB_ERROR_NO_DEVICE
 
 LIBUSB_ERROR_PIPE = -9
-LIBUSB_ERROR_NO_DEVICE = -4
 LIBUSB_ERROR_ACCESS = -3
 LIBUSB_ERROR_TIMEOUT = -7
 DEFAULT_SERIAL = "A00366A08793039A"
@@ -146,8 +146,7 @@ class EmulatedKinect(usb.backend.IBackend):
         with self._lock:
             self._update_plug()
             if handle.generation != self._generation:
-                raise USBError("No such device (it may have been disconnected)", LIBUSB_ERROR_NO_DEVICE,
-                               errno.ENODEV)
+                self._no_device()
 
     # --- IBackend: enumeration and descriptors -----------------------------------------------------------
     def enumerate_devices(self):
@@ -174,8 +173,7 @@ class EmulatedKinect(usb.backend.IBackend):
         with self._lock:
             self._update_plug()
             if self._generation < 0 or dev not in self.functions:
-                raise USBError("No such device (it may have been disconnected)", LIBUSB_ERROR_NO_DEVICE,
-                               errno.ENODEV)
+                self._no_device()
             if self.faults.access_denied:
                 raise USBError("Access denied (insufficient permissions)", LIBUSB_ERROR_ACCESS, errno.EACCES)
             return _Handle(dev, self._generation)
@@ -193,7 +191,7 @@ class EmulatedKinect(usb.backend.IBackend):
     def set_interface_altsetting(self, dev_handle, intf, altsetting):
         self.check_handle(dev_handle)
         if altsetting >= len(dev_handle.function.interfaces[intf]):
-            raise USBError("Pipe error", LIBUSB_ERROR_PIPE, errno.EPIPE)
+            self._stall()
         dev_handle.alt[intf] = altsetting
 
     def claim_interface(self, dev_handle, intf):
@@ -224,7 +222,7 @@ class EmulatedKinect(usb.backend.IBackend):
                 return self._camera_control(bmRequestType, bRequest, wValue, wIndex, data)
             if fn.kind == "motor":
                 return self._motor_control(bmRequestType, bRequest, wValue, data)
-            raise USBError("Pipe error", LIBUSB_ERROR_PIPE, errno.EPIPE)
+            self._stall()
 
     @staticmethod
     def _fill(data, payload: bytes) -> int:
@@ -237,12 +235,15 @@ class EmulatedKinect(usb.backend.IBackend):
             return self._fill(data, bytes([4, 3, 0x09, 0x04]))
         text = fn.strings().get(index)
         if not text:
-            raise USBError("Pipe error", LIBUSB_ERROR_PIPE, errno.EPIPE)
+            self._stall()
         body = text.encode("utf-16-le")
         return self._fill(data, bytes([2 + len(body), 3]) + body)
 
     def _stall(self):
         raise USBError("Pipe error", LIBUSB_ERROR_PIPE, errno.EPIPE)
+
+    def _no_device(self):
+        raise USBError("No such device (it may have been disconnected)", LIBUSB_ERROR_NO_DEVICE, errno.ENODEV)
 
     def _camera_control(self, rtype, request, value, index, data) -> int:
         if rtype == P.CMD_REQUEST_OUT and request == 0 and value == 0 and index == 0:
@@ -344,6 +345,6 @@ class EmulatedKinect(usb.backend.IBackend):
     def open_iso_pump(self, dev_handle, endpoint: int, transfers: int, packets_per_transfer: int):
         self.check_handle(dev_handle)
         if endpoint != P.DEPTH_ENDPOINT:
-            raise USBError("Pipe error", LIBUSB_ERROR_PIPE, errno.EPIPE)
+            self._stall()
         self.last_pump = EmulatedIsoPump(self, dev_handle, endpoint, transfers, packets_per_transfer)
         return self.last_pump
