@@ -29,6 +29,16 @@ def _mapped_ancestors(pose_bones, bone_names) -> tuple[list[int], list[int]]:
     return anchor, sorted(range(len(bone_names)), key=lambda k: depth[k])
 
 
+def read_rotations(pose_bones, index, flat: np.ndarray) -> np.ndarray:
+    """Armature-space 3x3 rotations of the pose bones at `index`, as Blender last evaluated them (one bulk
+    read into `flat`, a float32 buffer of 16 per pose bone; pose scale dropped)."""
+    pose_bones.foreach_get("matrix", flat)
+    # foreach_get flattens each 4x4 column by column
+    m = flat.reshape(-1, 4, 4)[index, :3, :3].transpose(0, 2, 1).astype(np.float64)
+    m /= np.linalg.norm(m, axis=-2, keepdims=True)  # drop any pose scale
+    return m
+
+
 def correct_for_evaluation(obj: bpy.types.Object, bone_names, quats: np.ndarray, root_bone: str | None,
                            root_location: np.ndarray, desired: np.ndarray, progress=None) -> np.ndarray:
     """quats (F, M, 4) solved assuming plain parenting, desired (F, M, 4) armature-space rotations ->
@@ -38,7 +48,8 @@ def correct_for_evaluation(obj: bpy.types.Object, bone_names, quats: np.ndarray,
     descendants, so a pass usually lands within tolerance and a second evaluation confirms it."""
     pose_bones = obj.pose.bones
     view_layer = bpy.context.view_layer
-    index = [list(pose_bones.keys()).index(n) for n in bone_names]
+    keys = list(pose_bones.keys())
+    index = [keys.index(n) for n in bone_names]
     anchor, order = _mapped_ancestors(pose_bones, bone_names)
     nb = len(pose_bones)
     flat = np.empty(nb * 16, dtype=np.float32)
@@ -54,9 +65,7 @@ def correct_for_evaluation(obj: bpy.types.Object, bone_names, quats: np.ndarray,
             set_rotations(pose_bones, bone_names, from_matrix(basis))
             obj.update_tag()
             view_layer.update()
-            pose_bones.foreach_get("matrix", flat)
-            actual = flat.reshape(nb, 4, 4).transpose(0, 2, 1)[index, :3, :3].astype(np.float64)
-            actual /= np.linalg.norm(actual, axis=-2, keepdims=True)  # drop any pose scale
+            actual = read_rotations(pose_bones, index, flat)
             turned = np.empty_like(actual)  # world change each bone receives this pass
             worst = 0.0
             for k in order:

@@ -27,7 +27,7 @@ from ..takes import load_take
 from .bake_take import bake_take
 from .mapping_ui import table_overrides
 from .pose_apply import apply_frame_pose, restore_pose, snapshot_pose
-from .evaluated_solve import correct_for_evaluation
+from .evaluated_solve import correct_for_evaluation, read_rotations
 from .preferences import get_preferences
 from .properties import ensure_defaults, target_armature
 from .rig_reader import constrained_bones, target_rig_from_object
@@ -110,9 +110,7 @@ class LiveController:
             self._pose_index = np.array([keys.index(name) for _, name in self._read])
             self._pose_count = len(pose_bones)
             self._flat = np.empty(self._pose_count * 16, dtype=np.float32)
-        pose_bones.foreach_get("matrix", self._flat)
-        m = self._flat.reshape(-1, 4, 4)[self._pose_index, :3, :3].transpose(0, 2, 1).astype(np.float64)
-        m /= np.linalg.norm(m, axis=-2, keepdims=True)  # drop pose scale
+        m = read_rotations(pose_bones, self._pose_index, self._flat)
         return {b: m[k] for k, (b, _) in enumerate(self._read)}
 
     # -- pumping ---------------------------------------------------------------------------------------------
