@@ -13,6 +13,7 @@ import numpy as np
 import usb.core
 import usb.util
 
+from . import protocol as P
 from .camera import access_advice, is_gone
 from .discovery import KinectInfo, find_kinect
 from .errors import AccessDenied, DeviceGone, MotorUnavailable, ProtocolError
@@ -47,7 +48,7 @@ class KinectMotor:
             raise MotorUnavailable(f"{info.model} {info.serial}: {info.motor_note or 'no motor device'}")
         self.info = info
         self.device = info.motor
-        self.via_audio = info.motor.idProduct not in (0x02B0, 0x02C2)
+        self.via_audio = info.motor.idProduct not in P.MOTOR_PIDS
         self._tag = 0
 
     def _io(self, fn, *args):
