@@ -9,9 +9,10 @@ from __future__ import annotations
 import math
 import struct
 
+from .motor import (ALT_CMD_LED, ALT_CMD_STATE, ALT_CMD_TILT, ALT_MAGIC, ALT_REPLY_MAGIC, COUNTS_PER_G,
+                    TILT_LIMIT_DEG)
+
 MOTOR_DEG_PER_S = 15.0
-TILT_LIMIT = 27.0
-COUNTS_PER_G = 819
 LED_CODES = range(7)
 
 
@@ -39,7 +40,7 @@ class EmulatedMotor:
         return 0, round(COUNTS_PER_G * math.cos(theta)), round(COUNTS_PER_G * math.sin(theta))
 
     def _aim(self, degrees: float) -> None:
-        self.target_deg = max(-TILT_LIMIT, min(TILT_LIMIT, degrees))
+        self.target_deg = max(-TILT_LIMIT_DEG, min(TILT_LIMIT_DEG, degrees))
 
     def control(self, rtype: int, request: int, value: int) -> bytes | None:
         """A control request to the 1414 motor device: reply bytes for IN requests, None for OUT."""
@@ -52,7 +53,7 @@ class EmulatedMotor:
             return None
         if rtype == 0xC0 and request == 0x32:
             moving = self.tilt_deg != self.target_deg
-            status = 4 if moving else (1 if abs(self.tilt_deg) >= TILT_LIMIT else 0)
+            status = 4 if moving else (1 if abs(self.tilt_deg) >= TILT_LIMIT_DEG else 0)
             return struct.pack(">2xhhhbB", *self._gravity(), round(self.tilt_deg * 2), status)
         if rtype == 0xC0 and request == 0x10:
             return b"\x22"
@@ -66,17 +67,17 @@ class EmulatedMotor:
         arg2 = struct.unpack_from("<i", data, 16)[0] if len(data) >= 20 else 0
         self._advance()
         replies, status = [], 0
-        if magic != 0x06022009:
+        if magic != ALT_MAGIC:
             status = 1
-        elif cmd == 0x803B:
+        elif cmd == ALT_CMD_TILT:
             self._aim(float(arg2))
-        elif cmd == 0x10:
+        elif cmd == ALT_CMD_LED:
             self.led = arg2
-        elif cmd == 0x8032:
+        elif cmd == ALT_CMD_STATE:
             body = bytearray(104)
             struct.pack_into("<4i", body, 16, *self._gravity(), round(self.tilt_deg))
             replies.append(bytes(body))
         else:
             status = 2
-        replies.append(struct.pack("<3I", 0x0A6FE000, tag, status))
+        replies.append(struct.pack("<3I", ALT_REPLY_MAGIC, tag, status))
         return replies
