@@ -10,12 +10,5 @@ import numpy as np
 
 
 def process_batch(pipeline, positions: np.ndarray, states: np.ndarray, times: np.ndarray):
-    """positions (K, J, 3), states (K, J), times (K,) -> FramePose of the last tracked frame, or None.
-    Pipelines without a batch step (test stand-ins) are stepped frame by frame."""
-    batch = getattr(pipeline, "process_frames", None)
-    if batch is not None:
-        return batch(positions, states, times)
-    pose = None
-    for p, s, t in zip(positions, states, times):
-        pose = pipeline.process_frame(p, s, float(t)) or pose
-    return pose
+    """positions (K, J, 3), states (K, J), times (K,) -> FramePose of the last tracked frame, or None."""
+    return pipeline.process_frames(positions, states, times)

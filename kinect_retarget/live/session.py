@@ -56,11 +56,7 @@ class LiveSession:
         self.running = True
 
     def _reset_pipeline(self) -> None:
-        if hasattr(self.pipeline, "reset"):
-            try:
-                self.pipeline.reset(self.source.rate)
-            except TypeError:
-                self.pipeline.reset()
+        self.pipeline.reset(self.source.rate)
 
     def now(self) -> float:
         """Seconds since start on the session clock."""

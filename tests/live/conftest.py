@@ -49,7 +49,7 @@ class StandInPipeline:
         self.reset()
         self.calls = 0
 
-    def reset(self):
+    def reset(self, rate=30.0):
         self.state = None
 
     def process_frame(self, positions, states, time_s):
@@ -60,6 +60,13 @@ class StandInPipeline:
         self.state = p if self.state is None else 0.5 * self.state + 0.5 * p
         return SimpleNamespace(root_location=self.state[0].copy(), quats=np.tile([1.0, 0, 0, 0], (3, 1)),
                                time_s=time_s, index=self.calls - 1)
+
+    def process_frames(self, positions, states, times):
+        """Frame by frame (the engine's batch step filters all and solves only the last; same pose)."""
+        pose = None
+        for p, s, t in zip(positions, states, times):
+            pose = self.process_frame(p, s, float(t)) or pose
+        return pose
 
 
 @pytest.fixture

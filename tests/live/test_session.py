@@ -115,7 +115,10 @@ def test_no_tracked_joints_holds_the_pose_then_stops(wave_take, stand_in, tmp_pa
 
 def test_engine_exception_stops_live_with_message(wave_take, tmp_path):
     class Broken:
-        def process_frame(self, *a):
+        def reset(self, rate=30.0):
+            pass
+
+        def process_frames(self, *a):
             raise ValueError("mapping names bone 'Spine' which the rig lacks")
     s = LiveSession(TakePlayback(wave_take, speed=10), Broken(), lambda p: None)
     s.start()
