@@ -64,6 +64,9 @@ class JointTracker:
         self.offsets = np.stack([ox.ravel(), oy.ravel()], axis=1)
         r2 = np.sum(self.offsets ** 2, axis=1) / (hh * hh)
         self.kernel = np.maximum(1.0 - r2, 0.0)  # Epanechnikov: the window's centre counts most
+        r = np.arange(-settings.search_px, settings.search_px + 1, 2, dtype=np.float64)
+        gy, gx = np.meshgrid(r, r, indexing="ij")
+        self.grid = np.stack([gx.ravel(), gy.ravel()], axis=1)  # template search offsets around the estimate
         q = _quantise(first)
         self.templates = self._histograms(q, self.pos)
         self.particles = np.repeat(self.pos[:, None, :], settings.particles, axis=1)
@@ -86,9 +89,7 @@ class JointTracker:
         wts /= np.maximum(wts.sum(axis=1, keepdims=True), 1e-300)
         estimate = np.einsum("kn,knc->kc", wts, self.particles)
         # template match around the prediction: the most similar window wins
-        r = np.arange(-s.search_px, s.search_px + 1, 2, dtype=np.float64)
-        gy, gx = np.meshgrid(r, r, indexing="ij")
-        grid = np.stack([gx.ravel(), gy.ravel()], axis=1)
+        grid = self.grid
         cand = estimate[:, None, :] + grid[None]
         cand[..., 0] = np.clip(cand[..., 0], 0, w - 1)
         cand[..., 1] = np.clip(cand[..., 1], 0, h - 1)
@@ -102,7 +103,7 @@ class JointTracker:
         self.lost = ~found
         good = sim > 0.8
         if good.any():  # follow slow changes of appearance
-            hist = self._histograms(q, new[good], np.flatnonzero(good))
+            hist = self._histograms(q, new[good])
             self.templates[good] = (1 - s.adapt) * self.templates[good] + s.adapt * hist
         # resample (systematic) for the next frame
         u = (self.rng.random((k, 1)) + np.arange(n)) / n
@@ -110,7 +111,7 @@ class JointTracker:
         self.particles = np.take_along_axis(self.particles, idx[..., None], axis=1)
         return TrackResult(self.pos.copy(), sim, found)
 
-    def _histograms(self, q: np.ndarray, centres: np.ndarray, _which=None) -> np.ndarray:
+    def _histograms(self, q: np.ndarray, centres: np.ndarray) -> np.ndarray:
         h, w = q.shape
         pts = np.round(centres[:, None, :] + self.offsets[None]).astype(np.int64)
         inside = (pts[..., 0] >= 0) & (pts[..., 0] < w) & (pts[..., 1] >= 0) & (pts[..., 1] < h)
