@@ -18,6 +18,15 @@ import numpy as np
 from .skeletons import NOT_TRACKED
 
 
+def _step_each(filt, positions: np.ndarray, states: np.ndarray) -> np.ndarray:
+    """A whole take through `filt.step`, frame by frame."""
+    positions = np.asarray(positions, dtype=np.float64)
+    out = np.empty_like(positions)
+    for i in range(positions.shape[0]):
+        out[i] = filt.step(positions[i], states[i])
+    return out
+
+
 @dataclass
 class DoubleExponentialFilter:
     """The Kinect SDK's joint filter (Holt double exponential smoothing with a jitter radius and a maximum
@@ -71,10 +80,7 @@ class DoubleExponentialFilter:
         return self._out.copy()
 
     def run(self, positions: np.ndarray, states: np.ndarray, times: np.ndarray | None = None) -> np.ndarray:
-        out = np.empty_like(np.asarray(positions, dtype=np.float64))
-        for i in range(out.shape[0]):
-            out[i] = self.step(positions[i], states[i])
-        return out
+        return _step_each(self, positions, states)
 
 
 @dataclass
@@ -97,6 +103,13 @@ class OneEuroFilter:
         tau = 1.0 / (2 * math.pi * cutoff)
         return 1.0 / (1.0 + tau / dt)
 
+    def _next_dt(self, t: float | None) -> float:
+        """Seconds since the previous frame (1/rate when either time is unknown or t does not rise); t
+        becomes the previous frame's time."""
+        dt = 1.0 / self.rate if t is None or self._t is None or t <= self._t else t - self._t
+        self._t = t
+        return dt
+
     def step(self, x: np.ndarray, states: np.ndarray, t: float | None = None) -> np.ndarray:
         x = np.asarray(x, dtype=np.float64)
         valid = (np.asarray(states) != NOT_TRACKED)[:, None]
@@ -105,8 +118,7 @@ class OneEuroFilter:
             self._seen = valid.copy()
             self._t = t
             return x.copy()
-        dt = 1.0 / self.rate if t is None or self._t is None or t <= self._t else t - self._t
-        self._t = t
+        dt = self._next_dt(t)
         self._advance(x, valid, dt, bool(valid.all() and self._seen.all()))
         return self._x.copy()
 
@@ -148,9 +160,7 @@ class OneEuroFilter:
         if all_valid[start:].all() and self._seen.all():
             return self._run_all_tracked(positions, out, start, times)
         for i in range(start, out.shape[0]):
-            t = None if times is None else float(times[i])
-            dt = 1.0 / self.rate if t is None or self._t is None or t <= self._t else t - self._t
-            self._t = t
+            dt = self._next_dt(None if times is None else float(times[i]))
             self._advance(positions[i], valid[i][:, None], dt, bool(all_valid[i] and self._seen.all()))
             out[i] = self._x
         return out
@@ -168,7 +178,7 @@ class OneEuroFilter:
             step = t - prev
             dts = np.where(np.isfinite(step) & (step > 0), step, dts)
             self._t = float(t[-1])
-        ads = 1.0 / (1.0 + (1.0 / (2 * math.pi * self.d_cutoff)) / dts)
+        ads = self._alpha(self.d_cutoff, dts)
         k_beta, k_min = self.beta * 2 * math.pi * dts, self.min_cutoff * 2 * math.pi * dts
         inv_dt = 1.0 / dts
         xp, dxh = self._x, self._dx
@@ -199,11 +209,7 @@ class HoldUntracked:
         return self._last.copy()
 
     def run(self, positions, states, times=None):
-        positions = np.asarray(positions, dtype=np.float64)
-        out = np.empty_like(positions)
-        for i in range(positions.shape[0]):
-            out[i] = self.step(positions[i], states[i])
-        return out
+        return _step_each(self, positions, states)
 
 
 FILTERS = ("none", "default", "one_euro", "kinect_sdk", "hold")
