@@ -11,13 +11,13 @@ from bpy.utils import escape_identifier
 
 from ..core.kinect_rig_layout import median_segment_lengths
 from ..core.pipeline import BakedMotion, RetargetPipeline, RetargetSettings
-from ..core.presets import RIGIFY_FK_SWITCHES, build_mapping, mapping_problems
+from ..core.presets import build_mapping, mapping_problems
 from ..core.take import Take
 from .bake import bake_motion
 from .evaluated_solve import correct_for_evaluation
 from .kinect_rig import build_kinect_rig
 from .pose_apply import restore_pose, snapshot_pose
-from .rig_reader import has_constrained_ancestry, target_rig_from_object
+from .rig_reader import fk_switch_bones, has_constrained_ancestry, target_rig_from_object
 
 Report = Callable[[set, str], None]
 
@@ -64,10 +64,9 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
         progress(0.3)
     extra = []
     if used == "rigify":
-        extra = [(f'pose.bones["{escape_identifier(b)}"]["IK_FK"]', b, np.ones(1)) for b in RIGIFY_FK_SWITCHES
-                 if b in obj.pose.bones and "IK_FK" in obj.pose.bones[b]]
+        extra = [(f'pose.bones["{escape_identifier(b)}"]["IK_FK"]', b, np.ones(1)) for b in fk_switch_bones(obj)]
     if has_constrained_ancestry(obj, motion.bone_names):
-        saved = {name: obj.pose.bones[name].get("IK_FK") for _, name, _ in extra}
+        saved = {name: obj.pose.bones[name]["IK_FK"] for _, name, _ in extra}
         saved_pose = snapshot_pose(obj)
         try:
             for _, name, _ in extra:
@@ -79,8 +78,7 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
         finally:  # the evaluation posed the rig; put the pose and the switches back whatever happened
             restore_pose(obj, saved_pose)
             for name, value in saved.items():
-                if value is not None:
-                    obj.pose.bones[name]["IK_FK"] = value
+                obj.pose.bones[name]["IK_FK"] = value
     name = action_name or f"{obj.name}_{take.metadata.get('name', 'take')}"
     action = bake_motion(obj, motion, name, extra)
     first, last = int(motion.frames[0]), int(motion.frames[-1])

@@ -17,7 +17,7 @@ import numpy as np
 from bpy.app.handlers import persistent
 
 from ..core.pipeline import RetargetPipeline, RetargetSettings
-from ..core.presets import RIGIFY_FK_SWITCHES, build_mapping
+from ..core.presets import build_mapping
 from ..core.take import TakeError
 from ..live.constrained import ConstrainedParentCorrection
 from ..live.calibration import PROPERTY as CALIBRATION_PROPERTY, Calibration, CalibrationError
@@ -30,7 +30,7 @@ from .pose_apply import apply_frame_pose, restore_pose, snapshot_pose
 from .evaluated_solve import correct_for_evaluation, read_rotations
 from .preferences import get_preferences
 from .properties import ensure_defaults, target_armature
-from .rig_reader import constrained_bones, target_rig_from_object
+from .rig_reader import constrained_bones, fk_switch_bones, target_rig_from_object
 
 usb_source_factory = None  # set by the USB panel (usb_panel.py): simulated Kinect, device freed from its preview
 TIMER_INTERVAL = 1 / 120  # pump often: latency is arrival -> applied, and an empty pump costs microseconds
@@ -83,10 +83,8 @@ class LiveController:
 
     def _rigify_fk(self, obj) -> None:
         # the preset drives Rigify's FK controls: switch the limbs to FK while live (restored on stop)
-        for name in RIGIFY_FK_SWITCHES:
-            pb = obj.pose.bones.get(name)
-            if pb is not None and "IK_FK" in pb:
-                pb["IK_FK"] = 1.0
+        for name in fk_switch_bones(obj):
+            obj.pose.bones[name]["IK_FK"] = 1.0
 
     def apply(self, pose) -> None:
         obj = self.obj()
@@ -258,8 +256,7 @@ def _save_state(obj) -> dict:
     ad = obj.animation_data
     action = ad.action if ad else None
     state = {"pose": snapshot_pose(obj),
-             "ik_fk": {n: obj.pose.bones[n]["IK_FK"] for n in RIGIFY_FK_SWITCHES
-                       if n in obj.pose.bones and "IK_FK" in obj.pose.bones[n]},
+             "ik_fk": {n: obj.pose.bones[n]["IK_FK"] for n in fk_switch_bones(obj)},
              "action": action.name if action else None,
              "slot": ad.action_slot.identifier if action is not None and ad.action_slot else None,
              "fake_user": action.use_fake_user if action is not None else False}

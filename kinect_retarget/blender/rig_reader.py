@@ -4,6 +4,7 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
+from ..core.presets import RIGIFY_FK_SWITCHES
 from ..core.target_rig import TargetRig
 
 GENERATED_TAG = "kinect_retarget_generated"
@@ -30,6 +31,12 @@ def target_rig_from_object(obj: bpy.types.Object) -> TargetRig:
     world = np.array(obj.matrix_world, dtype=np.float64)
     return TargetRig(obj.name, tuple(names), parents, rest, lengths.astype(np.float64), world, inherit,
                      generated=bool(obj.get(GENERATED_TAG, False)))
+
+
+def fk_switch_bones(obj: bpy.types.Object) -> list[str]:
+    """The Rigify FK/IK switch bones this rig has (RIGIFY_FK_SWITCHES with an 'IK_FK' property)."""
+    pose_bones = obj.pose.bones
+    return [name for name in RIGIFY_FK_SWITCHES if name in pose_bones and "IK_FK" in pose_bones[name]]
 
 
 def constrained_bones(obj: bpy.types.Object) -> set[str]:
