@@ -20,7 +20,7 @@ from .depth import jitter_px
 from .gaps import fill_gaps
 from .geometry import JointLines
 from .scale import SCALE_BONES, fill_missing, smooth_lengths, scale_envelope, scale_lower_bound, scale_paper
-from .smoothing import gaussian_smooth
+from .smoothing import gaussian_kernel, gaussian_smooth
 from .signs import SignPriors, choose_signs
 from .tracks2d import LiftError, Tracks2D
 
@@ -139,10 +139,9 @@ def _smoothing_gain(times: np.ndarray, sigma_s: float) -> float:
     """Factor by which gaussian_smooth reduces white noise (the kernel's L2 norm)."""
     if len(times) < 3 or sigma_s <= 0:
         return 1.0
-    sig = sigma_s / float(np.median(np.diff(times)))
-    if sig < 0.3:
+    k = gaussian_kernel(times, sigma_s)
+    if k is None:
         return 1.0
-    k = np.exp(-0.5 * (np.arange(-int(np.ceil(3 * sig)), int(np.ceil(3 * sig)) + 1) / sig) ** 2)
     return float(np.sqrt(np.sum((k / k.sum()) ** 2)))
 
 
