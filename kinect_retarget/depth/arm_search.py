@@ -54,7 +54,6 @@ IN_FRONT = 0.06        # m in front of the chest's surface: an arm, not the ches
 TORSO_BAND = 0.04      # fraction of height: bands of the trunk whose surface depth is taken apart
 HEAD_HALF_WIDTH = 0.065  # fraction of height: head and neck, above the shoulder line
 LEG_RADIUS = 0.09      # m around the fitted leg bones
-ELBOW_FROM_DEPTH = True    # tracked hands: the elbow on the IK circle chosen by this scoring
 ARM_UNSEEN_COST = 0.1      # per-sample search cost above which no arm was seen (hidden: keep the carried pose)
 ARM_RADIUS = 0.08      # m around an arm already placed: its cells are not the other arm's evidence
 
@@ -134,11 +133,8 @@ class ArmScorer:
         p = self.p
         shape = pts.shape[:-1]
         flat = pts.reshape(-1, 3)
-        rc = np.round((p.grid.to_pixel(flat) - [p.r0, p.c0]) / p.k).astype(np.int64)
-        h, w = p.mask.shape
-        ok = (rc[:, 0] >= 0) & (rc[:, 0] < h) & (rc[:, 1] >= 0) & (rc[:, 1] < w)
-        r, c = np.clip(rc[:, 0], 0, h - 1), np.clip(rc[:, 1], 0, w - 1)
-        on = ok & p.mask[r, c]
+        r, c, on = p.cells(flat)
+        w = p.mask.shape[1]
         dz = p.xyz[r, c, 2] - (flat[:, 2] - radius)   # > 0: the surface is seen behind the bone's front
         cover = on & self.evidence[r, c] & (np.abs(dz) <= COVER_TOL)
         cost = np.where(~on | (dz > FREE_SPACE), 1.0,
@@ -170,11 +166,13 @@ def search_arm(scorer: ArmScorer, shoulder, l1, l2, lh, H, prev_elbow=None, prev
     """Best arm chain -> (elbow, wrist, hand, cost per sample)."""
     n_samples = len(UPPER_T) + len(FORE_T) + len(HAND_T)
 
-    def prior(elbow, hand):
-        if prev_elbow is None or prev_hand is None:
-            return 0.0
-        return W_PREVIOUS * n_samples * (np.linalg.norm(elbow - prev_elbow, axis=-1)
-                                          + np.linalg.norm(hand - prev_hand, axis=-1))
+    def chains(u, v):
+        """Cost of every chain (u, v broadcast), with the previous pose's pull and the fold limit."""
+        cost, elbow, wrist, hand = _chain_cost(scorer, shoulder, u, v, l1, l2, lh, H)
+        if prev_elbow is not None and prev_hand is not None:
+            cost = cost + W_PREVIOUS * n_samples * (np.linalg.norm(elbow - prev_elbow, axis=-1)
+                                                    + np.linalg.norm(hand - prev_hand, axis=-1))
+        return cost + np.where(np.sum(u * v, -1) < FOLD_LIMIT, 10.0, 0.0), elbow, wrist, hand
 
     up = scorer.score([(shoulder + (l1 * DIRECTIONS)[:, None, :] * UPPER_T[:, None], UPPER_R * H)])
     up = up + INSIDE_COST * scorer.frame.inside(shoulder + l1 * DIRECTIONS)
@@ -182,19 +180,14 @@ def search_arm(scorer: ArmScorer, shoulder, l1, l2, lh, H, prev_elbow=None, prev
         up = up + W_PREVIOUS * n_samples * np.linalg.norm(shoulder + l1 * DIRECTIONS - prev_elbow, axis=-1)
     u = DIRECTIONS[np.argsort(up)[:UPPER_KEEP]]                       # (K, 3)
     v = np.broadcast_to(DIRECTIONS, (len(u),) + DIRECTIONS.shape)      # (K, N, 3)
-    uu = np.broadcast_to(u[:, None, :], v.shape)
-    cost, elbow, _, hand = _chain_cost(scorer, shoulder, uu, v, l1, l2, lh, H)
-    cost = cost + prior(elbow, hand) + np.where(np.sum(uu * v, -1) < FOLD_LIMIT, 10.0, 0.0)
+    cost, *_ = chains(np.broadcast_to(u[:, None, :], v.shape), v)
     k, n = np.unravel_index(int(np.argmin(cost)), cost.shape)
-    u0, v0 = u[k], DIRECTIONS[n]
     # refine: every pair of small offsets of both directions
-    ru = u0 + np.vstack([np.zeros(3), REFINE])
-    rv = v0 + np.vstack([np.zeros(3), REFINE])
+    ru = u[k] + np.vstack([np.zeros(3), REFINE])
+    rv = DIRECTIONS[n] + np.vstack([np.zeros(3), REFINE])
     ru /= np.linalg.norm(ru, axis=1, keepdims=True)
     rv /= np.linalg.norm(rv, axis=1, keepdims=True)
-    uu, vv = np.broadcast_arrays(ru[:, None, :], rv[None, :, :])
-    cost, elbow, wrist, hand = _chain_cost(scorer, shoulder, uu, vv, l1, l2, lh, H)
-    cost = cost + prior(elbow, hand) + np.where(np.sum(uu * vv, -1) < FOLD_LIMIT, 10.0, 0.0)
+    cost, elbow, wrist, hand = chains(*np.broadcast_arrays(ru[:, None, :], rv[None, :, :]))
     i, j = np.unravel_index(int(np.argmin(cost)), cost.shape)
     return elbow[i, j], wrist[i, j], hand[i, j], float(cost[i, j]) / n_samples
 
@@ -221,15 +214,14 @@ def fit_arms(pos, st, xyz, mask, proj, frame: TorsoFrame, H, prev=None, head_reg
     todo = [s for s in SIDES if st[J[f"Hand{s}"]] != TRACKED]
     evidence = arm_evidence(xyz, mask, pos, frame, head_region)
     lengths = (bm.UPPER_ARM * H, bm.FOREARM * H, bm.HAND * H)
-    if ELBOW_FROM_DEPTH:  # a tracked hand fixes the wrist; the elbow's place on its circle is the depth's call
-        for s in SIDES:
-            if s in todo:
-                continue
-            shoulder, wrist = pos[J[f"Shoulder{s}"]], pos[J[f"Wrist{s}"]]
-            cands, _ = two_bone_candidates(shoulder, wrist, lengths[0], lengths[1], n=24)
-            if len(cands) > 1:
-                pos[J[f"Elbow{s}"]], _ = best_elbow(ArmScorer(proj, evidence, frame), shoulder, cands, wrist, H,
-                                                    None if prev is None else prev[J[f"Elbow{s}"]])
+    for s in SIDES:   # a tracked hand fixes the wrist; the elbow's place on its circle is the depth's call
+        if s in todo:
+            continue
+        shoulder, wrist = pos[J[f"Shoulder{s}"]], pos[J[f"Wrist{s}"]]
+        cands, _ = two_bone_candidates(shoulder, wrist, lengths[0], lengths[1], n=24)
+        if len(cands) > 1:
+            pos[J[f"Elbow{s}"]], _ = best_elbow(ArmScorer(proj, evidence, frame), shoulder, cands, wrist, H,
+                                                None if prev is None else prev[J[f"Elbow{s}"]])
     if not todo:
         return
     for s in SIDES:

@@ -15,9 +15,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.skeletons import INFERRED, KINECT_V1, TRACKED
+from .arm_search import J
 from . import body_model_fit as bm
 
-J = {n: i for i, n in enumerate(KINECT_V1.joints)}
 TORSO = [J[n] for n in ("HipCenter", "Spine", "ShoulderCenter", "Head")]
 LOWER_TORSO = [J[n] for n in ("HipCenter", "Spine", "HipLeft", "HipRight")]
 SIDE_TORSO = [J[f"{p}{s}"] for p in ("Shoulder", "Hip") for s in ("Left", "Right")]
@@ -31,7 +31,6 @@ PREDICTION_SLACK = np.full(20, 0.25)
 PREDICTION_SLACK[TORSO + SIDE_TORSO] = 0.10
 VELOCITY_DAMPING = 0.5   # a fraction of the last frame's velocity is carried on (prediction, not extrapolation)
 MIN_EXTREMITIES = 3      # of head, hands and feet; fewer and the labelling of what was found is a guess
-EDGE_ON_DEMOTES = True   # side-on, the sides overlap in depth: limbs and shoulder/hip lines are guesses
 WARMUP_FRAMES = 6        # frames after (re)acquisition during which limbs are reported inferred (0.2 s)
 RECOVERY_FRAMES = 1      # frames a joint stays flagged after its checks pass again
 LIMB_DEPTH_INSIDE = np.array([bm.DEPTH_INSIDE[KINECT_V1.joints[j].replace("Left", "").replace("Right", "")]
@@ -68,7 +67,7 @@ class ConfidenceCheck:
         proj = getattr(fit, "projector", None)
         if proj is not None:
             doubt[LIMB] |= proj.cost(positions[LIMB], LIMB_DEPTH_INSIDE) >= OFF_SURFACE
-        if EDGE_ON_DEMOTES and getattr(fit, "edge_on", False):
+        if getattr(fit, "edge_on", False):   # side-on, the sides overlap in depth: limbs, shoulder/hip lines
             doubt[LIMB + SIDE_TORSO] = True
         found = {label for label, _ in getattr(fit, "extrema", [])}
         if "head" not in found:   # the torso was placed from the shoulder tops alone: the hips are far from it

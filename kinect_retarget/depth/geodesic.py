@@ -99,27 +99,6 @@ def geodesic_extrema(graph: SurfaceGraph, d0: np.ndarray, count: int = 6, min_di
     return out
 
 
-def geodesic_maxima(xyz: np.ndarray, d0: np.ndarray, count: int = 6, min_distance: float = 0.3,
-                    window: int = 9, separation: float = 0.15) -> list[tuple[int, int, float]]:
-    """Extremity candidates in one pass: cells whose geodesic distance from the torso is the largest in
-    their image neighbourhood (head, hand and foot tips end the body's branches), strongest first, at
-    least `separation` metres apart in 3D. Cheaper than `geodesic_extrema` (no extra geodesic runs)."""
-    d = np.where(np.isfinite(d0), d0, -1.0)
-    r = window // 2
-    pad = np.pad(d, r, constant_values=-1.0)
-    local = np.lib.stride_tricks.sliding_window_view(pad, (window, window)).max(axis=(2, 3))
-    rows, cols = np.nonzero((d >= local) & (d >= min_distance))
-    order = np.argsort(-d[rows, cols])
-    out: list[tuple[int, int, float]] = []
-    for i in order:
-        p = xyz[rows[i], cols[i]]
-        if all(np.linalg.norm(p - xyz[a, b]) > separation for a, b, _ in out):
-            out.append((int(rows[i]), int(cols[i]), float(d[rows[i], cols[i]])))
-            if len(out) == count:
-                break
-    return out
-
-
 def level_set_centroid(xyz: np.ndarray, dist: np.ndarray, level: float, width: float,
                        near: np.ndarray | None = None, radius: float = 0.25) -> np.ndarray | None:
     """Centroid of the surface points whose geodesic distance is within level +- width/2 (paper 003's

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.conventions import kinect_to_depth_pixel
+from ..core.conventions import depth_pixel_to_kinect, kinect_to_depth_pixel
 from .camera import DepthCamera
 
 MIN_Z, MAX_Z = 0.5, 4.5
@@ -32,9 +32,8 @@ class DepthGrid:
         z = np.where(valid, z, 0.0)
         u = np.arange(w) * step + step // 2
         v = np.arange(h) * step + step // 2
-        x = -(u[None, :] - camera.cx) * z / camera.f
-        y = -(v[:, None] - camera.cy) * z / camera.f
-        return cls(z, np.stack([x, y, z], axis=-1), valid, step, camera)
+        xyz = depth_pixel_to_kinect(u[None, :], v[:, None], z, camera.f, camera.cx, camera.cy)
+        return cls(z, xyz, valid, step, camera)
 
     def to_pixel(self, points: np.ndarray) -> np.ndarray:
         """(..., 3) Kinect points -> (..., 2) float grid coordinates (row, col)."""

@@ -15,32 +15,26 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED
+from ..core.skeletons import INFERRED, NOT_TRACKED, TRACKED
 from . import body_model_fit as bm
-from .arm_search import TorsoFrame, fit_arms
-from .geodesic import SurfaceGraph, geodesic_extrema, geodesic_maxima, level_set_centroid
+from .arm_search import SIDES, J, TorsoFrame, fit_arms
+from .geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
 from .limb_ends import at_image_border, occluded_end
 from .two_bone import two_bone_candidates
+from .two_bone import unit as _unit
 
-J = {n: i for i, n in enumerate(KINECT_V1.joints)}
 # weights of the elbow/knee choice on the IK circle (per metre): level-set centroid, previous frame
 W_LEVEL_SET, W_PREVIOUS = 1.0, 0.3
-GEODESIC_ROWS = 1000   # no subsampling below the tracker's grid: coarser cells merge arms with the body
-EXTREMA = "plagemann"     # "maxima" (one geodesic run) or "plagemann" (one run per extremum, slower)
-SIDES = ("Left", "Right")
 HEAD_AXIS_WEIGHT = 0.65      # torso axis pulled this far toward the line from the torso patch to the head top
 MAX_SIDE_LEAN_DEG = 20.0    # sideways component of a lean beyond which the "head" is not trusted to tilt
 MAX_LEAN_DEG = 60.0         # a "head" farther than this from upright is taken for something else
 AXIS_GRAVITY_WEIGHT = 0.75  # torso axis = this blend of gravity's up and the torso patch's long axis
 SIDE_ON_WIDTH = 0.165       # visible chest width / height below which the torso is taken as seen side-on
-MID_NEEDS_SUPPORT = True    # an elbow/knee is tracked only where the depth image backs it (projective check)
 CONTINUITY_RADIUS = 0.25    # m a lone hand/foot may move from a tracked one and still be taken for it
 HEAD_REGION = 0.12          # fraction of height along the surface from the head's extremum: head and neck
 ARM_SEARCH = True           # arms without a hand extremity: search poses against the depth (arm_search)
 TRUNCATED_EXTEND = 0.5      # a limb leaving the image continues this fraction of its remaining reach
-OCCLUDED_ENDS = True        # an extremity beside a nearer surface is where the limb is hidden, not its end
 W_MIDLINE = 1.0             # per metre a knee lies across the body's midline
-PREDICTED_SIDES = True      # left/right continuity against the motion's prediction, not the last position
 BEHIND_FREE, BEHIND_COST = 0.06, 0.5   # m behind the surface a joint may sit for free; cost per metre beyond
 SUPPORT_BEHIND = 0.08       # m behind the surface seen at its pixel an elbow/knee may sit and still be tracked
 TURNED_DEG = 45.0           # facing estimate turned this far: shoulders and hips overlap in depth, inferred
@@ -54,14 +48,8 @@ class FitResult:
     lateral: np.ndarray
     extrema: list = field(default_factory=list)   # [(label, xyz)] for previews and tests
     torso_centre: np.ndarray | None = None
-    head_top: np.ndarray | None = None
     projector: "Projector | None" = None          # for the confidence checks after the fit
     edge_on: bool = False                          # the chest's normal was unusable (seen side-on)
-
-
-def _unit(v):
-    n = np.linalg.norm(v)
-    return v / n if n > 1e-9 else v
 
 
 def _nearest_cell(xyz: np.ndarray, mask: np.ndarray, p: np.ndarray) -> tuple[int, int] | None:
@@ -75,18 +63,24 @@ def _nearest_cell(xyz: np.ndarray, mask: np.ndarray, p: np.ndarray) -> tuple[int
 class Projector:
     """Projective agreement between 3D joint hypotheses and the cropped depth surface."""
 
-    def __init__(self, grid, crop, xyz, mask):
-        self.grid, self.r0, self.c0, self.k, self.xyz, self.mask = grid, crop[0], crop[1], crop[2], xyz, mask
+    def __init__(self, grid, origin, xyz, mask):
+        self.grid, self.r0, self.c0, self.xyz, self.mask = grid, origin[0], origin[1], xyz, mask
 
-    def depth_offset(self, pts: np.ndarray, inside) -> tuple[np.ndarray, np.ndarray]:
-        """(dz, on): how far each point lies behind the surface seen at its pixel, less `inside` (the joint's
-        depth below the skin), and whether that pixel is on the person."""
-        rc = np.round((self.grid.to_pixel(pts) - [self.r0, self.c0]) / self.k).astype(np.int64)
+    def cells(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(row, col, on) of each (N, 3) point in the cropped grid: its cell (clipped into the crop) and
+        whether that cell is inside the crop and on the person."""
+        rc = np.round(self.grid.to_pixel(pts) - [self.r0, self.c0]).astype(np.int64)
         h, w = self.mask.shape
         ok = (rc[:, 0] >= 0) & (rc[:, 0] < h) & (rc[:, 1] >= 0) & (rc[:, 1] < w)
         r = np.clip(rc[:, 0], 0, h - 1)
         c = np.clip(rc[:, 1], 0, w - 1)
-        return pts[:, 2] - (self.xyz[r, c, 2] + inside), ok & self.mask[r, c]
+        return r, c, ok & self.mask[r, c]
+
+    def depth_offset(self, pts: np.ndarray, inside) -> tuple[np.ndarray, np.ndarray]:
+        """(dz, on): how far each point lies behind the surface seen at its pixel, less `inside` (the joint's
+        depth below the skin), and whether that pixel is on the person."""
+        r, c, on = self.cells(pts)
+        return pts[:, 2] - (self.xyz[r, c, 2] + inside), on
 
     def cost(self, pts: np.ndarray, inside) -> np.ndarray:
         dz, on = self.depth_offset(pts, inside)
@@ -100,21 +94,20 @@ class Projector:
         return bool(on[0] and -0.04 <= dz[0] <= SUPPORT_BEHIND)
 
 
-def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_states: np.ndarray | None,
+def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states: np.ndarray | None,
                prev_lateral: np.ndarray | None, prev_centre: np.ndarray | None = None,
-               prev_head_top: np.ndarray | None = None, predicted: np.ndarray | None = None) -> FitResult | None:
+               predicted: np.ndarray | None = None) -> FitResult | None:
     """One frame's skeleton for the segmented person. `prev`/`prev_states`/`prev_lateral`: the last output;
     `predicted`: where the motion so far says the joints are now (continuity for left/right labels)."""
     rows, cols = np.nonzero(mask_full)
     r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
-    # geodesics on a grid about 60 cells tall whatever the distance: constant cost per frame
-    k = max(1, int(round((r1 - r0) / GEODESIC_ROWS)))
-    xyz = grid.xyz[r0:r1:k, c0:c1:k]
-    mask = mask_full[r0:r1:k, c0:c1:k]
-    cell = float(np.median(xyz[mask][:, 2])) * grid.step * k / grid.camera.f   # metres per cell
+    # the person's bounding box of the tracker's grid (no coarser: coarser cells merge arms with the body)
+    xyz = grid.xyz[r0:r1, c0:c1]
+    mask = mask_full[r0:r1, c0:c1]
+    cell = float(np.median(xyz[mask][:, 2])) * grid.step / grid.camera.f   # metres per cell
     band = lambda w: max(w, 1.5 * cell)
     graph = SurfaceGraph(xyz, mask, max_jump=0.06)
-    proj = Projector(grid, (r0, c0, k), xyz, mask)
+    proj = Projector(grid, (r0, c0), xyz, mask)
     H = calib.height
     # --- torso ---------------------------------------------------------------------------------------
     seed_p = prev_centre if prev_centre is not None else grid.xyz[mask_full].mean(axis=0)
@@ -154,8 +147,7 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
         lat = _unit(lat - (lat @ axis) * axis)
     inside = lambda name: view * bm.DEPTH_INSIDE[name]
     # --- extremities ---------------------------------------------------------------------------------
-    extrema = (geodesic_extrema(loose, d0, count=6, min_distance=0.15 * H, iterations=4) if EXTREMA == "plagemann"
-               else geodesic_maxima(xyz, d0, count=6, min_distance=0.15 * H, window=max(3, int(0.12 / cell) | 1)))
+    extrema = geodesic_extrema(loose, d0, count=6, min_distance=0.15 * H, iterations=4)
     cand = []
     for r, c, dist in extrema:
         p = xyz[r, c]
@@ -229,8 +221,7 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
                   ("Hip", "Knee", "Ankle", "Foot", bm.THIGH, bm.SHIN, feet, 0.07, 0.15))
     legs_clipped = 0
     for root, mid, end, tip, r1, r2, found, d_tip, d_end in limb_specs:
-        assign = _assign_sides(found, prev if predicted is None or not PREDICTED_SIDES else predicted, prev_states,
-                               tip, lat, centre)
+        assign = _assign_sides(found, prev if predicted is None else predicted, prev_states, tip, lat, centre)
         for s in SIDES:
             e = assign.get(s)
             a = pos[J[f"{root}{s}"]]
@@ -264,9 +255,9 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
                 end_p = (tip_p if end_p is None else end_p + inside(end))
                 mid_ls = level_set_centroid(xyz, de, d_end + l2, band(0.06), end_p, l2 + 0.1)
                 labels.append((f"{tip}{s}", e[1]))
-                clipped = at_image_border(grid, (r0 + e[0][0] * k, c0 + e[0][1] * k))
+                clipped = at_image_border(grid, (r0 + e[0][0], c0 + e[0][1]))
                 legs_clipped += int(clipped and root == "Hip")
-                truncated = clipped or (OCCLUDED_ENDS and occluded_end(xyz, mask, e[0]))
+                truncated = clipped or occluded_end(xyz, mask, e[0])
                 if truncated:  # the limb leaves the image or goes behind the body: its extremity is where the
                     # view ends, not where the limb does
                     reach_left = max(0.0, l1 + l2 - np.linalg.norm(end_p - a))
@@ -304,7 +295,7 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
             if np.linalg.norm(reach_shift) > REACH_SLACK:
                 st_limb = INFERRED  # the extremity is out of this limb's reach: not its hand/foot, or a bad root
             mid_ok = st_limb == TRACKED and proj.supported(m, bm.DEPTH_INSIDE[mid] - 0.02)
-            st[J[f"{mid}{s}"]] = TRACKED if mid_ok or (st_limb == TRACKED and not MID_NEEDS_SUPPORT) else INFERRED
+            st[J[f"{mid}{s}"]] = TRACKED if mid_ok else INFERRED
             st[J[f"{end}{s}"]] = st[J[f"{tip}{s}"]] = st_limb
     if ARM_SEARCH:
         fit_arms(pos, st, xyz, mask, proj, TorsoFrame(centre, axis, lat, facing, pos, H), H, prev, head_region)
@@ -317,7 +308,7 @@ def fit_person(grid, mask_full, floor, up, calib, prev: np.ndarray | None, prev_
     if facing @ -view < np.cos(np.radians(TURNED_DEG)):
         for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
             st[J[name]] = INFERRED
-    return FitResult(pos, st, lat, labels, centre, None if head is None else head[1], proj, edge_on or narrow)
+    return FitResult(pos, st, lat, labels, centre, proj, edge_on or narrow)
 
 
 def _visible_chest_width(pts, centre, axis, view, H):
@@ -361,7 +352,7 @@ def _hanging_arm(xyz, mask, shoulder, axis, lat, sign, centre, H):
         return None
     far = np.argsort(-below[ok])[:5]   # a few lowest points: the finger tips
     tip = pts[ok][far].mean(axis=0)
-    return tip - axis * 0.0
+    return tip
 
 
 def _carry(prev, s, end, tip, root_pos, axis, pos, root):

@@ -109,17 +109,15 @@ def render_sequence(bvh_path: str, mesh_dir: str, scenario: Scenario | None = No
         verts_all.append(v)
         floor.append(v[..., 1].min(axis=1))
     lift = room.floor_y - np.percentile(np.concatenate(floor), 2)
-    if bystander is not None:
+    if bystander is not None:   # standing still: rendered once into the background
         bystander[:, 1] += room.floor_y - bystander[:, 1].min()
         bystander = bystander @ to_cam.T
+        background = np.minimum(background, fill_pinholes(splat(surface_points(bystander, body.quads, groups), cam)))
     joints = (posed.joints @ yaw.T + shift[:, None] + [0, lift, 0]) @ to_cam.T
     raw = np.empty((nf, cam.height, cam.width), np.uint16)
     for i, v in enumerate(np.concatenate(verts_all)):
         v = (v + [0, lift, 0]) @ to_cam.T
-        depth = fill_pinholes(splat(surface_points(v, body.quads, groups), cam))
-        if bystander is not None:
-            depth = np.minimum(depth, fill_pinholes(splat(surface_points(bystander, body.quads, groups), cam)))
-        depth = np.minimum(depth, background)
+        depth = np.minimum(fill_pinholes(splat(surface_points(v, body.quads, groups), cam)), background)
         raw[i] = kinect_artifacts(depth, cam, rng, noise_raw=sc.noise_raw)
     times = np.arange(nf) / fps
     uv_x = kinect_to_depth_pixel(joints, cam.f, cam.cx, cam.cy)[..., 0]

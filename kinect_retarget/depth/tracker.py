@@ -53,7 +53,6 @@ class SkeletonTracker:
         self._last_seen: float | None = None
         self.last_grid: DepthGrid | None = None
         self.last_mask: np.ndarray | None = None
-        self.last_fit: FitResult | None = None
         self.last_good: FitResult | None = None
 
     def set_gravity(self, gravity) -> None:
@@ -81,7 +80,7 @@ class SkeletonTracker:
         except (TypeError, ValueError):
             ts = float("nan")
         grid = DepthGrid.from_mm(d, self.camera, self.settings.step)
-        self.last_grid, self.last_mask, self.last_fit = grid, None, None
+        self.last_grid, self.last_mask = grid, None
         if grid.valid.sum() < 100:
             self._lose(ts)
             return self._none("no depth readings in this frame")
@@ -96,14 +95,12 @@ class SkeletonTracker:
             self._lose(ts)
             return self._none("no person in view")
         last = self.last_good
-        fit = fit_person(grid, person.mask, self.floor, up, self.calibration, self._prev, self._prev_states,
-                         self._lateral, None if last is None else last.torso_centre,
-                         None if last is None else last.head_top, self.confidence.predict())
+        fit = fit_person(grid, person.mask, up, self.calibration, self._prev, self._prev_states, self._lateral,
+                         None if last is None else last.torso_centre, self.confidence.predict())
         if fit is None or not np.all(np.isfinite(fit.positions)):
             self._lose(ts)
             return self._none("person found but no skeleton fitted")
         pos, st = fit.positions, self.confidence.assess(fit.positions, fit.states, fit)
-        self.last_grid = grid
         self._calibrate(person, fit, up)
         if self._prev is not None and self.settings.smoothing > 0:
             step = np.linalg.norm(pos - self._prev, axis=1, keepdims=True)
@@ -112,7 +109,7 @@ class SkeletonTracker:
         self.confidence.remember(pos)
         self._prev, self._prev_states, self._lateral = pos.copy(), fit.states.copy(), fit.lateral
         self._person_centroid, self._last_seen = person.centroid, ts
-        self.last_mask, self.last_fit, self.last_good = person.mask, fit, fit
+        self.last_mask, self.last_good = person.mask, fit
         self.status = "tracking" if self.calibration.frames else "tracking (calibrating)"
         return pos, st
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 
-def _unit(v):
+def unit(v):
     n = np.linalg.norm(v)
     return v / n if n > 1e-9 else v
 
@@ -25,7 +25,7 @@ def two_bone_candidates(a: np.ndarray, c: np.ndarray, l1: float, l2: float, n: i
     x = (d * d + l1 * l1 - l2 * l2) / (2 * d)
     r = np.sqrt(max(l1 * l1 - x * x, 0.0))
     ref = np.array([0.0, 0.0, 1.0]) if abs(u[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
-    e1 = _unit(np.cross(u, ref))
+    e1 = unit(np.cross(u, ref))
     e2 = np.cross(u, e1)
     ang = np.linspace(0, 2 * np.pi, n, endpoint=False)
     return a + u * x + r * (np.cos(ang)[:, None] * e1 + np.sin(ang)[:, None] * e2), a + u * d
