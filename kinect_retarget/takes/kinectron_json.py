@@ -14,10 +14,8 @@ import numpy as np
 
 from ..core.skeletons import KINECT_V2, TRACKED
 from ..core.take import Take, TakeError, nominal_rate
+from ._kinect_v2_images import COLOR_SIZE, DEPTH_SIZE, unmirror
 from ._numeric import read_bytes
-
-DEPTH_SIZE = (512, 424)     # Kinect v2 depth image, pixels (width, height)
-COLOR_SIZE = (1920, 1080)   # Kinect v2 colour image
 _FIELDS = ("cameraX", "cameraY", "cameraZ", "depthX", "depthY", "colorX", "colorY",
            "orientationW", "orientationX", "orientationY", "orientationZ")
 
@@ -85,18 +83,12 @@ def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
     depth_px, color_px = table[..., 3:5] * DEPTH_SIZE, table[..., 5:7] * COLOR_SIZE
     two_d = {
         "depth": table[..., 3:5], "color": table[..., 5:7], "depth_px": depth_px, "color_px": color_px,
-        "depth_px_unmirrored": _unmirror(depth_px, DEPTH_SIZE[0]),
-        "color_px_unmirrored": _unmirror(color_px, COLOR_SIZE[0]),
+        "depth_px_unmirrored": unmirror(depth_px, DEPTH_SIZE[0]),
+        "color_px_unmirrored": unmirror(color_px, COLOR_SIZE[0]),
         "orientation": table[..., 7:11],
         "left_hand_state": hands[:, 0].astype(np.uint8), "right_hand_state": hands[:, 1].astype(np.uint8),
     }
     return take, two_d
-
-
-def _unmirror(px: np.ndarray, width: int) -> np.ndarray:
-    out = px.copy()
-    out[..., 0] = (width - 1) - px[..., 0]
-    return out
 
 
 def _load(path: str) -> list:

@@ -14,11 +14,10 @@ import numpy as np
 
 from ..core.skeletons import KINECT_V2, NOT_TRACKED
 from ..core.take import Take, TakeError
+from ._kinect_v2_images import COLOR_SIZE, DEPTH_SIZE, unmirror
 from ._numeric import _raise_non_numeric, field_counts, normalise, read_bytes
 
 RATE = 30.0
-DEPTH_SIZE = (512, 424)
-COLOR_SIZE = (1920, 1080)
 BODY_FIELDS = 10
 JOINT_FIELDS = 12
 
@@ -109,8 +108,8 @@ def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
     take = Take(KINECT_V2, table[..., :3], states, times, RATE, "ntu_skeleton", meta)
     depth, color = table[..., 3:5], table[..., 5:7]
     return take, {"depth_px": depth, "color_px": color, "orientation": table[..., 7:11],
-                  "depth_px_unmirrored": depth * [-1, 1] + [DEPTH_SIZE[0] - 1, 0],
-                  "color_px_unmirrored": color * [-1, 1] + [COLOR_SIZE[0] - 1, 0], "body_count": body_count}
+                  "depth_px_unmirrored": unmirror(depth, DEPTH_SIZE[0]),
+                  "color_px_unmirrored": unmirror(color, COLOR_SIZE[0]), "body_count": body_count}
 
 
 def _layout_fast(kinds: np.ndarray, first: np.ndarray, n_frames: int):
