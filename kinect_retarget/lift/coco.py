@@ -9,11 +9,10 @@ from __future__ import annotations
 
 import json
 import os
-import re
 
 import numpy as np
 
-from .keypoints import outside_image, summarise, to_tracks
+from .keypoints import natural_key, outside_image, summarise, to_tracks
 from .schemes import COCO_17, COCO_17_TO_V1
 from .tracks2d import LiftError, Tracks2D
 
@@ -29,7 +28,7 @@ def read(path: str | os.PathLike, fps: float = 30.0, image_size=None) -> Tracks2
     if not images:
         raise LiftError(f"{path}: no images and no annotations with keypoints")
     if all(images[i].get("file_name") for i in images):
-        order = sorted(images, key=lambda i: _natural_key(images[i]["file_name"]))
+        order = sorted(images, key=lambda i: natural_key(images[i]["file_name"]))
     else:
         order = sorted(images, key=lambda i: (str(type(i)), i))
     size = image_size or _common_size(images, order)
@@ -140,10 +139,6 @@ def _common_size(images, order):
 def _label(images, image_id) -> str:
     name = images.get(image_id, {}).get("file_name")
     return f"image {image_id}" + (f" ({name})" if name else "")
-
-
-def _natural_key(name: str):
-    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", str(name))]
 
 
 def _joints_touched(occluded: np.ndarray) -> np.ndarray:

@@ -7,6 +7,7 @@ import re
 
 import numpy as np
 
+from .keypoints import natural_key
 from .tracks2d import LiftError
 
 NATIVE = (".ppm", ".pgm", ".pnm", ".npy")
@@ -19,8 +20,7 @@ def list_frames(folder: str) -> list[str]:
     names = [n for n in os.listdir(folder) if n.lower().endswith(ANY)]
     if not names:
         raise LiftError(f"{folder}: no image frames ({', '.join(ANY)})")
-    key = lambda n: [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", n)]  # noqa: E731
-    return [os.path.join(folder, n) for n in sorted(names, key=key)]
+    return [os.path.join(folder, n) for n in sorted(names, key=natural_key)]
 
 
 def load_frame(path: str) -> np.ndarray:

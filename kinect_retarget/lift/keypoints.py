@@ -1,12 +1,19 @@
 """Shared last step of the keypoint readers: drop impossible points (naming them) and map onto Kinect v1."""
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from .schemes import SYNTHETIC_V1
 from .tracks2d import Tracks2D, combine
 
 MAX_NOTES = 12  # problems listed one by one before they are summarised
+
+
+def natural_key(name) -> list:
+    """Sort key putting frame_2 before frame_10: digit runs compare as numbers."""
+    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", str(name))]
 
 
 def outside_image(uv: np.ndarray, conf: np.ndarray, size, names, source: str, labels) -> tuple[np.ndarray, list[str]]:

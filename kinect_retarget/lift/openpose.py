@@ -12,7 +12,7 @@ import re
 
 import numpy as np
 
-from .keypoints import outside_image, summarise, to_tracks
+from .keypoints import natural_key, outside_image, summarise, to_tracks
 from .schemes import BODY_25, BODY_25_TO_V1
 from .tracks2d import LiftError, Tracks2D
 
@@ -25,11 +25,7 @@ def keypoint_files(folder: str) -> list[str]:
     names = [n for n in os.listdir(folder) if n.endswith("_keypoints.json")]
     if not names:
         raise LiftError(f"{folder}: no *_keypoints.json files (OpenPose writes <video>_<frame>_keypoints.json)")
-    return sorted(names, key=_natural_key)
-
-
-def _natural_key(name: str):
-    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
+    return sorted(names, key=natural_key)
 
 
 def _frame_number(name: str, fallback: int) -> int:
