@@ -9,7 +9,7 @@ import numpy as np
 from .core.filters import FILTERS
 from .core.presets import PRESET_NAMES
 from .core.retarget import ROOT_MODES
-from .takes import detect_format, load_take
+from .takes import load_take
 
 
 def add_parsers(sub) -> None:
@@ -35,7 +35,7 @@ def add_parsers(sub) -> None:
 
 def take_summary(path: str) -> dict:
     take = load_take(path)
-    return {"file": os.path.basename(path), "format": detect_format(path), "skeleton": take.skeleton.name,
+    return {"file": os.path.basename(path), "format": take.source_format, "skeleton": take.skeleton.name,
             "joints": len(take.skeleton), "frames": take.frame_count, "duration_s": round(take.duration, 3),
             "rate_fps": take.rate, "tracked_fraction": round(take.tracked_fraction, 4),
             "frames_with_body": int(np.count_nonzero(take.any_tracked)),
