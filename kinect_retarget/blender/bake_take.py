@@ -12,6 +12,7 @@ from bpy.utils import escape_identifier
 from ..core.kinect_rig_layout import median_segment_lengths
 from ..core.pipeline import BakedMotion, RetargetPipeline, RetargetSettings
 from ..core.presets import build_mapping, mapping_problems
+from ..core.skeletons import Skeleton
 from ..core.take import Take
 from .bake import bake_motion
 from .evaluated_solve import correct_for_evaluation
@@ -38,12 +39,13 @@ def new_generated_rig(scene: bpy.types.Scene, take: Take, name: str = "KinectRig
     return build_kinect_rig(scene, take.skeleton, median_segment_lengths(take), name)
 
 
-def make_pipeline(obj: bpy.types.Object, take: Take, preset: str = "auto",
+def make_pipeline(obj: bpy.types.Object, skeleton: Skeleton, preset: str = "auto",
                   overrides: dict[str, str] | None = None,
                   settings: RetargetSettings | None = None) -> tuple[RetargetPipeline, str]:
+    """The pipeline from `skeleton` onto armature `obj` (bake and live), and the preset used."""
     rig = target_rig_from_object(obj)
     used, mapping = build_mapping(preset, rig.bone_names, overrides)
-    return RetargetPipeline(take.skeleton, rig, mapping, settings), used
+    return RetargetPipeline(skeleton, rig, mapping, settings), used
 
 
 def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
@@ -56,7 +58,7 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
     Raises ValueError (wrong armature, no mapped bone) before anything in the scene changes.
     """
     settings = settings or RetargetSettings()
-    pipeline, used = make_pipeline(obj, take, preset, overrides, settings)
+    pipeline, used = make_pipeline(obj, take.skeleton, preset, overrides, settings)
     for problem in mapping_problems(pipeline.rig.bone_names, overrides):
         report({"WARNING"}, problem)
     motion = pipeline.process_take(take)

@@ -16,21 +16,20 @@ import bpy
 import numpy as np
 from bpy.app.handlers import persistent
 
-from ..core.pipeline import RetargetPipeline, RetargetSettings
-from ..core.presets import build_mapping
+from ..core.pipeline import RetargetSettings
 from ..core.take import TakeError
 from ..live.constrained import ConstrainedParentCorrection
 from ..live.calibration import PROPERTY as CALIBRATION_PROPERTY, Calibration, CalibrationError
 from ..live.session import LiveSession
 from ..sources import OscReceiver, SourceError, TakePlayback, UsbKinectSource
 from ..takes import load_take
-from .bake_take import bake_take
+from .bake_take import bake_take, make_pipeline
 from .mapping_ui import table_overrides
 from .pose_apply import apply_frame_pose, restore_pose, snapshot_pose
 from .evaluated_solve import correct_for_evaluation, read_rotations
 from .preferences import get_preferences
 from .properties import ensure_defaults, target_armature
-from .rig_reader import constrained_bones, fk_switch_bones, target_rig_from_object
+from .rig_reader import constrained_bones, fk_switch_bones
 
 usb_source_factory = None  # set by the USB panel (usb_panel.py): simulated Kinect, device freed from its preview
 TIMER_INTERVAL = 1 / 120  # pump often: latency is arrival -> applied, and an empty pump costs microseconds
@@ -345,11 +344,9 @@ def start_live(context, source=None, use_timer: bool = True) -> LiveController:
     label = "custom source"
     if source is None:
         source, label = make_source(s, prefs)
-    rig = target_rig_from_object(obj)
     overrides = table_overrides(s)
-    used, mapping = build_mapping(s.preset, rig.bone_names, overrides)
     settings = RetargetSettings(filter=s.filter, root_mode=s.root, mirror=s.mirror)
-    pipeline = RetargetPipeline(source.skeleton, rig, mapping, settings)
+    pipeline, used = make_pipeline(obj, source.skeleton, s.preset, overrides, settings)
     cal_text = obj.get(CALIBRATION_PROPERTY)
     if cal_text:
         try:
