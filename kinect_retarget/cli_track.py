@@ -72,7 +72,7 @@ def load_capture(path: str):
 
 def load_replay(path: str):
     from .device.calibration import Calibration
-    from .device.depth_unpack import unpack_11bit
+    from .device.decode import decode_frame
     from .device.dump import replay_dump
     frames, _, err = replay_dump(path)
     if err is not None:
@@ -81,7 +81,7 @@ def load_replay(path: str):
         raise TakeError(f"{path}: the dump holds no complete depth frame")
     cal = Calibration()
     lut = cal.raw_to_mm_table()
-    mm = np.stack([cal.to_mm(unpack_11bit(f.packed), lut) for f in frames])
+    mm = np.stack([decode_frame(f, lut)[1] for f in frames])   # as capture and live decode them
     ticks = np.array([f.timestamp for f in frames], dtype=np.int64)
     return mm, _times_from({"timestamp": ticks}, len(frames), path), None
 

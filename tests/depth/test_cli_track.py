@@ -82,3 +82,26 @@ def test_track_replays_a_usb_packet_dump(rendered, tmp_path):
     (tmp_path / "cut.dump").write_bytes(data[: len(data) * 3 // 4 + 7])
     assert main(["track", "--replay", str(tmp_path / "cut.dump"), "--out", str(out)]) == 0
     assert load_take(out).frame_count == 3
+
+
+def test_replayed_frame_with_a_lost_packet_does_not_pass_filler_for_depth(rendered, tmp_path):
+    """The pixels of a packet lost on the wire are "no reading" for the tracker, as `capture --replay` and
+    the live stream decode them (device/decode.py), not whatever filler the reassembly left there."""
+    from kinect_retarget.cli_track import load_replay
+    from kinect_retarget.device.dump import DumpWriter
+    from kinect_retarget.device.emulated_stream import DEPTH_PACKETS_PER_FRAME, packets_for_frames
+    seq, _ = rendered
+    packets = packets_for_frames(list(seq.raw[:3]), 3)
+    lost = DEPTH_PACKETS_PER_FRAME + DEPTH_PACKETS_PER_FRAME // 2   # mid-image (the person) of frame 1
+    dump = tmp_path / "lossy.dump"
+    with DumpWriter(dump) as w:
+        w.write_packets(packets[:lost] + packets[lost + 1:])
+    mm, _, _ = load_replay(str(dump))
+    from kinect_retarget.device.dump import replay_dump
+    frames, _, _ = replay_dump(dump)
+    holey = [i for i, f in enumerate(frames) if f.holes]
+    assert holey, "the lost packet left no hole"
+    for i in holey:
+        for start, end in frames[i].holes:
+            first, last = (8 * start) // 11, (8 * end - 1) // 11
+            assert np.all(mm[i].reshape(-1)[first:last + 1] == 0)
