@@ -7,12 +7,11 @@ feet or hands: the lifter infers them. Several people in one image: the one near
 """
 from __future__ import annotations
 
-import json
 import os
 
 import numpy as np
 
-from .keypoints import natural_key, outside_image, summarise, to_tracks
+from .keypoints import natural_key, nearest_person, outside_image, read_json, summarise, to_tracks
 from .schemes import COCO_17, COCO_17_TO_V1
 from .tracks2d import LiftError, Tracks2D
 
@@ -68,17 +67,10 @@ def read(path: str | os.PathLike, fps: float = 30.0, image_size=None) -> Tracks2
 
 
 def _load(path: str):
-    try:
-        with open(path, "r", encoding="utf-8") as fh:
-            text = fh.read()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise LiftError(f"{path}: cannot read ({exc})") from None
-    if not text.strip():
-        raise LiftError(f"{path}: file is empty")
-    try:
-        return json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise LiftError(f"{path}: malformed JSON at line {exc.lineno} column {exc.colno} ({exc.msg})") from None
+    data, err = read_json(path)
+    if err is not None:
+        raise LiftError(f"{path}: {err}")
+    return data
 
 
 def _images_and_annotations(path: str, data):
@@ -120,11 +112,7 @@ def _choose(people, prev):
         return None
     if prev is None or len(people) == 1:
         return max(people, key=lambda p: float(np.sum(p[:, 2] > 0)))
-
-    def distance(p):
-        both = (p[:, 2] > 0) & (prev[:, 2] > 0)
-        return float(np.median(np.linalg.norm(p[both, :2] - prev[both, :2], axis=1))) if both.any() else np.inf
-    return min(people, key=distance)
+    return nearest_person(people, prev)
 
 
 def _common_size(images, order):

@@ -1,6 +1,8 @@
-"""Shared last step of the keypoint readers: drop impossible points (naming them) and map onto Kinect v1."""
+"""What the keypoint readers share: reading a JSON file, sorting names, picking a person, and the last step:
+drop impossible points (naming them) and map onto Kinect v1."""
 from __future__ import annotations
 
+import json
 import re
 
 import numpy as np
@@ -14,6 +16,29 @@ MAX_NOTES = 12  # problems listed one by one before they are summarised
 def natural_key(name) -> list:
     """Sort key putting frame_2 before frame_10: digit runs compare as numbers."""
     return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", str(name))]
+
+
+def read_json(path: str):
+    """(data, None) for a readable JSON file, else (None, why): unreadable, empty or malformed."""
+    try:
+        with open(path, "r", encoding="utf-8") as fh:
+            text = fh.read()
+    except (OSError, UnicodeDecodeError) as exc:
+        return None, f"cannot read ({exc})"
+    if not text.strip():
+        return None, "file is empty"
+    try:
+        return json.loads(text), None
+    except json.JSONDecodeError as exc:
+        return None, f"malformed JSON at line {exc.lineno} column {exc.colno} ({exc.msg})"
+
+
+def nearest_person(people: list[np.ndarray], prev: np.ndarray) -> np.ndarray:
+    """The person (K, 3: x, y, confidence) whose keypoints seen in both are, in median, nearest prev's."""
+    def distance(p):
+        both = (p[:, 2] > 0) & (prev[:, 2] > 0)
+        return float(np.median(np.linalg.norm(p[both, :2] - prev[both, :2], axis=1))) if both.any() else np.inf
+    return min(people, key=distance)
 
 
 def outside_image(uv: np.ndarray, conf: np.ndarray, size, names, source: str, labels) -> tuple[np.ndarray, list[str]]:

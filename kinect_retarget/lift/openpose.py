@@ -12,7 +12,7 @@ import re
 
 import numpy as np
 
-from .keypoints import natural_key, outside_image, summarise, to_tracks
+from .keypoints import natural_key, nearest_person, outside_image, read_json, summarise, to_tracks
 from .schemes import BODY_25, BODY_25_TO_V1
 from .tracks2d import LiftError, Tracks2D
 
@@ -67,17 +67,9 @@ def read(folder: str | os.PathLike, fps: float = 30.0, image_size=None) -> Track
 
 def _people(path: str):
     """The file's people as (P, 25, 3) arrays, or an error message."""
-    try:
-        with open(path, "r", encoding="utf-8") as fh:
-            text = fh.read()
-    except (OSError, UnicodeDecodeError) as exc:
-        return None, f"cannot read ({exc})"
-    if not text.strip():
-        return None, "file is empty"
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        return None, f"malformed JSON at line {exc.lineno} column {exc.colno} ({exc.msg})"
+    data, err = read_json(path)
+    if err is not None:
+        return None, err
     if not isinstance(data, dict) or not isinstance(data.get("people"), list):
         return None, "no 'people' list (not an OpenPose keypoint file)"
     out = []
@@ -104,11 +96,7 @@ def _choose(people: list[np.ndarray], prev: np.ndarray | None):
         return None
     if prev is None or len(people) == 1:
         return max(people, key=lambda p: float(p[:, 2].sum()))  # the most confidently seen person
-
-    def distance(p):
-        both = (p[:, 2] > 0) & (prev[:, 2] > 0)
-        return float(np.median(np.linalg.norm(p[both, :2] - prev[both, :2], axis=1))) if both.any() else np.inf
-    return min(people, key=distance)
+    return nearest_person(people, prev)
 
 
 def write_frame(path: str, uv: np.ndarray, conf: np.ndarray) -> None:
