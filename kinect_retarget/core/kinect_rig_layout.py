@@ -91,19 +91,13 @@ def generated_rig(skeleton: Skeleton, lengths: np.ndarray, name: str = "KinectRi
     pos = rest_joint_positions(skeleton, lengths)
     get = resolver(skeleton.joints, pos)
     rest = np.tile(np.eye(4), (len(skeleton), 1, 1))
-    bone_len = np.empty(len(skeleton))
-    parents = np.empty(len(skeleton), dtype=np.int64)
     for j, name_j in enumerate(skeleton.joints):
         p = skeleton.parents[j]
-        if p < 0:
-            head, y, bone_len[j], parents[j] = pos[j], UP, lengths[j], -1
-            hint = np.cross(y, get("HipLeft") - get("HipRight")) if "HipLeft" in skeleton.joints else LEFT
-        else:
-            head, y, bone_len[j], parents[j] = pos[p], rest_direction(name_j), lengths[j], p
-            hint = segment_hint(get, name_j, y, LEFT, UP)
-        rest[j, :3, :3] = frame_from_y_hint(y, hint)
+        head, y = (pos[j], UP) if p < 0 else (pos[p], rest_direction(name_j))
+        rest[j, :3, :3] = frame_from_y_hint(y, segment_hint(get, name_j, y, LEFT, UP))  # root: the pelvis
         rest[j, :3, 3] = head
-    return TargetRig(name, skeleton.joints, parents, rest, bone_len, generated=True)
+    return TargetRig(name, skeleton.joints, skeleton.parent_array.copy(), rest, np.array(lengths, dtype=np.float64),
+                     generated=True)
 
 
 def generated_mapping(skeleton: Skeleton) -> dict[str, str]:
