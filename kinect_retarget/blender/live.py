@@ -237,7 +237,7 @@ class LiveController:
             _controller = None
         if bpy.app.timers.is_registered(_timer):
             bpy.app.timers.unregister(_timer)
-        _redraw()
+        redraw_3d_views()
 
 
 def _unused_path(folder: str, base: str, ext: str) -> tuple[str, str]:
@@ -288,7 +288,8 @@ def _restore_state(obj, state: dict, keep_animation: bool) -> None:
         action.use_fake_user = state.get("fake_user", False)
 
 
-def _redraw() -> None:
+def redraw_3d_views() -> None:
+    """Tag every 3D viewport for a redraw (live and the USB panel's depth preview)."""
     wm = getattr(bpy.context, "window_manager", None)
     if wm is None:
         return
@@ -310,7 +311,7 @@ def _timer():
         alive = False
     if not alive:
         return None
-    _redraw()
+    redraw_3d_views()
     return TIMER_INTERVAL
 
 

@@ -279,7 +279,7 @@ def update_preview() -> float | None:
             _upload(rgba)
             changed = True
         if changed:
-            _redraw()
+            live.redraw_3d_views()
     except Exception as exc:  # a timer that raises is dropped silently by Blender: say it, and go on
         print(f"kinect_retarget: depth preview: {type(exc).__name__}: {exc}")
     busy = discovering() or _preparing_simulated() or stream_running() or live_uses_usb()
@@ -290,14 +290,6 @@ def ensure_timer() -> None:
     if not bpy.app.timers.is_registered(update_preview):
         # persistent: a stream outlives a file load, so must the timer that shows it (the image is recreated)
         bpy.app.timers.register(update_preview, first_interval=0.0, persistent=True)
-
-
-def _redraw() -> None:
-    wm = getattr(bpy.context, "window_manager", None)
-    for window in (wm.windows if wm is not None else ()):
-        for area in window.screen.areas:
-            if area.type == "VIEW_3D":
-                area.tag_redraw()
 
 
 # -- live on the USB Kinect ------------------------------------------------------------------------------------
