@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core import quat
 from ..core.skeletons import KINECT_V1
 from .mesh import Mesh, load_obj
 
@@ -137,7 +138,7 @@ def rotations_from_makehuman_bvh(mh: MakeHuman, motion, frame: int = 0) -> np.nd
     a = _procrustes(motion.rest_positions[[names.index(b) for b in common]],
                     mh.heads[[mh.bones.index(b) for b in common]])
     rot = np.tile(np.eye(3), (len(mh.bones), 1, 1))
-    g = _quat_to_matrix(motion.rotations[frame])
+    g = quat.to_matrix(motion.rotations[frame])
     for i, b in enumerate(mh.bones):
         if b in names:
             rot[i] = a @ g[names.index(b)] @ a.T
@@ -158,7 +159,7 @@ def rotations_from_cmu(mh: MakeHuman, motion, frame: int) -> np.ndarray:
     left /= np.linalg.norm(left)
     front = np.cross(left, up)
     a = np.stack([left, up, front])  # rows: CMU lab -> (x left, y up, z front) = MakeHuman OBJ axes
-    g = _quat_to_matrix(motion.rotations[frame])
+    g = quat.to_matrix(motion.rotations[frame])
     # The root's heading is removed: only the body's own articulation matters here.
     root = a @ g[0] @ a.T
     yaw = np.arctan2(root[0, 2], root[2, 2])
@@ -182,14 +183,6 @@ def rotations_from_cmu(mh: MakeHuman, motion, frame: int) -> np.ndarray:
         else:
             rot[i] = unyaw @ root
     return rot
-
-
-def _quat_to_matrix(q: np.ndarray) -> np.ndarray:
-    w, x, y, z = np.moveaxis(np.asarray(q, dtype=np.float64), -1, 0)
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], -2)
 
 
 def joint_errors(found: np.ndarray, reference: np.ndarray, height: float) -> np.ndarray:
