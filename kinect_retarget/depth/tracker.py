@@ -35,10 +35,12 @@ class TrackerSettings:
 class SkeletonTracker:
     def __init__(self, camera: DepthCamera | None = None, gravity=None, settings: TrackerSettings | None = None):
         self.camera = camera or DepthCamera()
-        self.gravity = None if gravity is None else np.asarray(gravity, dtype=np.float64)
+        self.gravity: np.ndarray | None = None
         self.settings = settings or TrackerSettings()
         self.skeleton = KINECT_V1
         self.reset()
+        if gravity is not None:
+            self.set_gravity(gravity)   # any scale (an accelerometer reads about 9.8): kept as a unit vector
 
     def reset(self) -> None:
         self.floor: FloorPlane | None = None

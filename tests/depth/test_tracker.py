@@ -81,3 +81,17 @@ def test_feet_out_of_the_image_are_not_claimed(rendered, camera):
         assert np.all(st[hips] != TRACKED)                  # both legs clipped: nothing below checks the hips
         rows = camera.cy - camera.f * pos[foot, 1] / pos[foot, 2]
         assert np.all(rows > 480 - 8)                      # continued past the edge, not stopped on it
+
+
+def test_gravity_of_any_scale_gives_the_same_skeleton(rendered):
+    """An accelerometer reads about 9.8 m/s^2, the synthetic frames carry a unit vector: the tracker keeps
+    only the direction. Without a floor in view (rows below the hips blanked) it leans on gravity alone."""
+    seq, _ = rendered
+    frames = seq.mm[:4].copy()
+    frames[:, 300:] = 0
+    unit, scaled = SkeletonTracker(gravity=seq.gravity), SkeletonTracker(gravity=9.81 * np.asarray(seq.gravity))
+    for i, frame in enumerate(frames):
+        a, b = unit.update(frame, seq.times[i]), scaled.update(frame, seq.times[i])
+        assert unit.floor is None
+        np.testing.assert_allclose(a[0], b[0], atol=1e-9)
+        np.testing.assert_array_equal(a[1], b[1])
