@@ -33,7 +33,7 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper):
 
     @classmethod
     def poll(cls, context):
-        if _target(context) is None:
+        if target_armature(context) is None:
             cls.poll_message_set("Select an armature to bake onto")
             return False
         return True
@@ -46,7 +46,7 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper):
         return super().invoke(context, event)
 
     def execute(self, context):
-        obj = _target(context)
+        obj = target_armature(context)
         wm = context.window_manager
         try:
             take = load_take(self.filepath)
@@ -72,14 +72,6 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper):
         finally:
             wm.progress_end()
         return {"FINISHED"}
-
-
-def _target(context):
-    """The sidebar's target armature when the add-on's settings exist, else the active armature."""
-    if getattr(context.scene, "kinect_retarget", None) is not None:
-        return target_armature(context)
-    obj = context.active_object
-    return obj if obj is not None and obj.type == "ARMATURE" else None
 
 
 CLASSES = (KINECT_RETARGET_OT_bake_take,)

@@ -70,8 +70,9 @@ def ensure_defaults(scene: bpy.types.Scene, context=None) -> None:
 
 
 def target_armature(context) -> bpy.types.Object | None:
-    s = context.scene.kinect_retarget
-    if s.armature is not None:
+    """The sidebar's target armature when the add-on's settings exist and name one, else the active armature."""
+    s = getattr(context.scene, "kinect_retarget", None)
+    if s is not None and s.armature is not None:
         return s.armature
     obj = context.active_object
     return obj if obj is not None and obj.type == "ARMATURE" else None
