@@ -2,7 +2,8 @@
 Python; no Blender needed). `--simulate` runs any of them against the emulated Kinect instead of USB hardware.
 
 Exit codes follow the rest of the CLI: 2 for bad input (arguments, a missing or damaged file), 1 when the
-device fails (none found, no permission, unplugged, libusb missing, nothing captured).
+device fails (none found, no permission, unplugged, libusb missing, nothing captured). Errors are raised and
+cli.main prints them and picks the code; only a capture that saved frames before failing returns its code.
 """
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ import numpy as np
 
 from .device.calibration import Calibration
 from .device.decode import decode_frame
-from .device.errors import BadInputFile, KinectError
+from .device.errors import KinectError
 from .device.protocol import TICKS_PER_FRAME, TIMESTAMP_HZ
 
 SIMULATE_HELP = "use the emulated Kinect instead of USB hardware"
@@ -77,22 +78,13 @@ def _backend(args):
     return EmulatedKinect(load_fakenect_dir(folder) if folder else synthetic_depth_frames())
 
 
-def _fail(exc: Exception) -> int:
-    """Print the reason and return the exit code: the user's input (2) or the device (1) is to blame."""
-    print(f"error: {exc}", file=sys.stderr)
-    return BAD_INPUT if isinstance(exc, (BadInputFile, ValueError, OSError)) else DEVICE_FAILURE
-
-
 # --- devices ---------------------------------------------------------------------------------------------------
 def run_devices(args) -> int:
     from .device.discovery import UDEV_RULES, UDEV_RULES_PATH, list_devices, udev_rule_install_command
     if args.udev_rule:
         print(f"# {UDEV_RULES_PATH}\n{UDEV_RULES}\n# install it with:\n{udev_rule_install_command()}")
         return 0
-    try:
-        kinects = list_devices(_backend(args))
-    except KinectError as exc:
-        return _fail(exc)
+    kinects = list_devices(_backend(args))
     if args.json:
         for k in kinects:
             print(json.dumps({"model": k.model, "serial": k.serial, "bus": k.bus, "address": k.address,
@@ -148,19 +140,16 @@ def _capture_replay(args) -> int:
 
 def run_capture(args) -> int:
     if args.seconds <= 0 and not args.replay:
-        return _fail(ValueError("--seconds must be positive"))
+        raise ValueError("--seconds must be positive")
     if args.wait < 0:
-        return _fail(ValueError("--wait must not be negative"))
+        raise ValueError("--wait must not be negative")
     if args.simulate_from and not args.simulate:
-        return _fail(ValueError("--simulate-from only applies to --simulate"))
+        raise ValueError("--simulate-from only applies to --simulate")
     if args.calibration and not args.replay:
-        return _fail(ValueError("--calibration only applies to --replay (a live capture reads the device's)"))
-    try:
-        if args.replay:
-            return _capture_replay(args)
-        return _capture_live(args)
-    except KinectError as exc:
-        return _fail(exc)
+        raise ValueError("--calibration only applies to --replay (a live capture reads the device's)")
+    if args.replay:
+        return _capture_replay(args)
+    return _capture_live(args)
 
 
 def _frame_ticks(timestamp: int, previous: int | None) -> int:
@@ -216,7 +205,7 @@ def _capture_live(args) -> int:
             dump.close()
     status = stream.status
     if not raws:
-        return _fail(KinectError(f"no depth frame was captured ({last_message}); nothing written"))
+        raise KinectError(f"no depth frame was captured ({last_message}); nothing written")
     _save(args.out, raws, mms, stamps, lost, calibration)
     print(f"{len(raws)} frames -> {args.out} (dropped {status.frames_dropped}, "
           f"packets lost {status.packets_lost})" + (f"; packets -> {args.dump}" if dump else ""))
@@ -234,29 +223,19 @@ def _motor(args):
 
 
 def run_tilt(args) -> int:
-    try:
-        motor = _motor(args)
-        sent = motor.set_tilt(args.angle)
-    except KinectError as exc:
-        return _fail(exc)
+    sent = _motor(args).set_tilt(args.angle)
     print(f"tilting to {sent:g} degrees" + (" (clamped to the ±27 degree range)" if sent != args.angle else ""))
     return 0
 
 
 def run_led(args) -> int:
-    try:
-        _motor(args).set_led(args.mode)
-    except KinectError as exc:
-        return _fail(exc)
+    _motor(args).set_led(args.mode)
     print(f"LED {args.mode}")
     return 0
 
 
 def run_accel(args) -> int:
-    try:
-        state = _motor(args).state()
-    except KinectError as exc:
-        return _fail(exc)
+    state = _motor(args).state()
     x, y, z = state.accel_g
     tilt = "unknown" if state.tilt_deg is None else f"{state.tilt_deg:g} degrees"
     print(f"accelerometer (g): x {x:+.3f}  y {y:+.3f}  z {z:+.3f}\ntilt: {tilt} ({state.status})")
