@@ -278,6 +278,6 @@ def autorig_to_file(mesh: Mesh, out_path: str, *, take=None, render_dir: str | N
         os.makedirs(render_dir, exist_ok=True)
         note = f"auto-rigged {obj.name}" + (f" + {take.metadata.get('name', 'take')}" if take is not None else "")
         out["renders"] = stage_and_render(scene, [obj], render_frames, render_dir, obj.name, note=note)
-    os.makedirs(os.path.dirname(os.path.abspath(out_path)), exist_ok=True)
-    bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out_path), check_existing=False)
+    from .headless import save_blend
+    save_blend(out_path)
     return out

@@ -30,6 +30,17 @@ def find_armature(name: str | None) -> bpy.types.Object:
     return arms[0]
 
 
+def blender_message(exc: Exception) -> str:
+    """The text of an error a bpy operator raised, without Blender's "Error: " prefix."""
+    return str(exc).strip().removeprefix("Error: ").strip()
+
+
+def save_blend(path: str) -> None:
+    """Save the open file as `path`, making its folder when needed."""
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(path), check_existing=False)
+
+
 def open_blend(path: str) -> None:
     """Open a .blend, with a one-line error for a missing or unreadable file."""
     if not os.path.isfile(path):
@@ -37,7 +48,7 @@ def open_blend(path: str) -> None:
     try:
         bpy.ops.wm.open_mainfile(filepath=os.path.abspath(path), load_ui=False)
     except RuntimeError as exc:
-        message = str(exc).strip().removeprefix("Error: ").strip().splitlines()[-1]
+        message = blender_message(exc).splitlines()[-1]
         raise ValueError(f"{path}: not a readable .blend file ({message})") from None
 
 
@@ -59,8 +70,7 @@ def bake_to_file(take: Take, out_path: str, *, rig_path: str | None = None, arma
         if "WARNING" in level:
             print(f"warning: {msg}", file=sys.stderr)
     result = bake_take(obj, take, preset=preset, overrides=overrides, settings=settings, report=report)
-    os.makedirs(os.path.dirname(os.path.abspath(out_path)), exist_ok=True)
-    bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out_path), check_existing=False)
+    save_blend(out_path)
     return {"out": out_path, "armature": obj.name, "preset": result.preset, "action": result.action.name,
             "frames": len(result.motion.frames), "frame_range": list(result.frame_range),
             "bones": len(result.motion.bone_names), "message": messages[-1] if messages else ""}

@@ -408,7 +408,7 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
     """The `live` command: open the rig (or build the generated one with `rig_lengths`), run the pump loop
     for `seconds` (or until the source ends), bake the recording, save `out`. Returns the statistics."""
     from .. import register, unregister
-    from .headless import find_armature, open_blend
+    from .headless import blender_message, find_armature, open_blend, save_blend
     from .kinect_rig import build_kinect_rig
     from .mapping_ui import fill_table
 
@@ -462,20 +462,15 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
         if hasattr(source, "bad_packets"):
             result["bad_packets"] = source.bad_packets
         if out:
-            os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
             try:
-                bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out), check_existing=False)
+                save_blend(out)
             except RuntimeError as exc:  # the recording (if any) is already on disk
-                raise ValueError(f"{out}: cannot save ({_blender_message(exc)})") from None
+                raise ValueError(f"{out}: cannot save ({blender_message(exc)})") from None
             result["out"] = os.path.abspath(out)
     finally:
         stop_live(bake=False)
         unregister()
     return result
-
-
-def _blender_message(exc: Exception) -> str:
-    return str(exc).strip().removeprefix("Error: ").strip()
 
 
 # -- operators -----------------------------------------------------------------------------------------------
