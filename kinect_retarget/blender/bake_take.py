@@ -39,6 +39,12 @@ def new_generated_rig(scene: bpy.types.Scene, take: Take, name: str = "KinectRig
     return build_kinect_rig(scene, take.skeleton, median_segment_lengths(take), name)
 
 
+def set_scene_rate(scene: bpy.types.Scene, rate: float) -> None:
+    """Run the scene at `rate` frames per second (an integer fps and the base that makes it exact)."""
+    scene.render.fps = max(1, int(round(rate)))
+    scene.render.fps_base = scene.render.fps / rate
+
+
 def make_pipeline(obj: bpy.types.Object, skeleton: Skeleton, preset: str = "auto",
                   overrides: dict[str, str] | None = None,
                   settings: RetargetSettings | None = None) -> tuple[RetargetPipeline, str]:
@@ -86,8 +92,7 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
     first, last = int(motion.frames[0]), int(motion.frames[-1])
     if set_scene_range:
         scene = bpy.context.scene
-        scene.render.fps = max(1, int(round(motion.fps)))
-        scene.render.fps_base = scene.render.fps / motion.fps
+        set_scene_rate(scene, motion.fps)
         scene.frame_start, scene.frame_end = first, last
     skipped = motion.extras.get("skipped_bones", ())
     report({"INFO"}, f"Baked {len(motion.frames)} frames ({len(motion.bone_names)} bones, preset {used}) "

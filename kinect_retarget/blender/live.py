@@ -23,7 +23,7 @@ from ..live.calibration import PROPERTY as CALIBRATION_PROPERTY, Calibration, Ca
 from ..live.session import LiveSession
 from ..sources import OscReceiver, SourceError, TakePlayback, UsbKinectSource
 from ..takes import load_take
-from .bake_take import bake_take, make_pipeline
+from .bake_take import bake_take, make_pipeline, set_scene_rate
 from .mapping_ui import table_overrides
 from .pose_apply import apply_frame_pose, restore_pose, snapshot_pose
 from .evaluated_solve import correct_for_evaluation, read_rotations
@@ -425,9 +425,7 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
         register()
         obj = build_kinect_rig(bpy.context.scene, source.skeleton, rig_lengths, "KinectRig")
         preset = "kinect" if preset == "auto" else preset
-        render = bpy.context.scene.render  # a new scene runs at the source's rate, as `bake` sets it
-        render.fps = max(1, int(round(source.rate)))
-        render.fps_base = render.fps / source.rate
+        set_scene_rate(bpy.context.scene, source.rate)  # a new scene runs at the source's rate, as `bake` sets it
     try:
         bpy.context.view_layer.objects.active = obj
         s = bpy.context.scene.kinect_retarget
