@@ -24,7 +24,7 @@ import bpy  # noqa: E402
 from kinect_retarget.autorig import Mesh, autorig, load_mesh  # noqa: E402
 from kinect_retarget.autorig.orient import upright_transform  # noqa: E402
 from kinect_retarget.blender.autorig_op import autorig_to_file, new_mesh_object  # noqa: E402
-from kinect_retarget.blender.render import stage_and_render  # noqa: E402
+from kinect_retarget.blender.render import render_still, stage  # noqa: E402
 from kinect_retarget.takes import load_take  # noqa: E402
 
 
@@ -63,10 +63,8 @@ def sticks(a, b, radius, mat, name):
     return obj
 
 
-def skeleton_picture(mesh: Mesh) -> None:
-    rig = autorig(mesh)
-    m = upright_transform(mesh.vertices, np.asarray(rig.features.up), np.asarray(rig.features.front),
-                          rig.height, rig.joints[0])
+def skeleton_picture(mesh: Mesh, rig, m: np.ndarray) -> None:
+    """rig: autorig(mesh); m: its upright transform (4x4)."""
     to_world = lambda p: p @ m[:3, :3].T + m[:3, 3]  # noqa: E731
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
@@ -81,21 +79,18 @@ def skeleton_picture(mesh: Mesh) -> None:
     paper_pts = to_world(rig.paper.points)
     markers(paper_pts, 0.011, blue, "PaperPoints")
     shading = scene.display.shading
-    stage_and_render(scene, [body], [1], str(HERE), "skeleton",
-                     note="auto-rig: Kinect joints (red), paper 003 skeleton points (blue)")
+    stage(scene, [body], [1], note="auto-rig: Kinect joints (red), paper 003 skeleton points (blue)")
     shading.show_xray = True
     shading.xray_alpha = 0.35
-    from kinect_retarget.blender.render import render_still
     render_still(scene, str(HERE / "skeleton.png"), 1)
-    os.remove(HERE / "skeleton_f0001.png")
 
 
 def main() -> None:
     mesh = load_mesh(DATA / "meshes" / "makehuman" / "base.obj", group="body")
-    skeleton_picture(mesh)
     rig = autorig(mesh)
     m = upright_transform(mesh.vertices, np.asarray(rig.features.up), np.asarray(rig.features.front),
                           rig.height, rig.joints[0])
+    skeleton_picture(mesh, rig, m)
     take = load_take(DATA / "kinect_v2" / "recorded_skeleton.json")
     take.metadata.setdefault("name", "recorded_skeleton")
     out = autorig_to_file(Mesh(mesh.vertices @ m[:3, :3].T + m[:3, 3], mesh.faces, "MakeHuman"),
