@@ -46,11 +46,11 @@ def rest_height(armature: bpy.types.Object) -> float:
     return max(float(np.ptp(points, axis=0).max()), 1e-3) if len(points) else 1.0
 
 
-def body_bones(armature: bpy.types.Object) -> list[str]:
+def body_bones(armature: bpy.types.Object, height: float | None = None) -> list[str]:
     """Deform bones worth a capsule: Rigify's DEF bones on a generated Rigify rig, else every deform bone;
-    facial, finger and very short bones are left out."""
+    facial, finger and very short bones are left out. height: rest_height(armature), when already known."""
     bones = armature.data.bones
-    height = rest_height(armature)
+    height = rest_height(armature) if height is None else height
     names = [b.name for b in bones if b.use_deform]
     if any(n.startswith("DEF-") for n in names):
         names = [n for n in names if n.startswith("DEF-")]
@@ -134,13 +134,13 @@ def add_body_mesh(armature: bpy.types.Object, bones: list[str] | None = None, na
     if armature is None or armature.type != "ARMATURE":
         raise ValueError("a body mesh needs an armature object")
     arm_bones = armature.data.bones
-    names = list(bones) if bones is not None else body_bones(armature)
+    height = rest_height(armature)
+    names = list(bones) if bones is not None else body_bones(armature, height)
     missing = [n for n in names if n not in arm_bones]
     if missing:
         raise ValueError(f"armature {armature.name!r} has no bone {', '.join(map(repr, missing))}")
     if not names:
         raise ValueError(f"armature {armature.name!r} has no deform bone to put a body on")
-    height = rest_height(armature)
     lengths = np.array([arm_bones[n].length for n in names])
     radii = np.array([bone_radius(n, l, height) for n, l in zip(names, lengths)])
     rings, faces = capsule_template(segments)
