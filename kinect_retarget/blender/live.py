@@ -54,11 +54,10 @@ class LiveController:
         try:
             self._rigify_fk(obj)
             pipeline = session.pipeline
-            corrector = ConstrainedParentCorrection(pipeline.rig, pipeline.bone_names, constrained_bones(obj)) \
-                if hasattr(pipeline, "rig") else None
-            self.corrector = corrector if corrector is not None and corrector.active else None
+            corrector = ConstrainedParentCorrection(pipeline.rig, pipeline.bone_names, constrained_bones(obj))
+            self.corrector = corrector if corrector.active else None
             self.update_after_apply = bool(bpy.app.background)
-            self.exact = bool(getattr(scene.kinect_retarget, "exact_constrained", False))
+            self.exact = bool(scene.kinect_retarget.exact_constrained)
             if self.corrector is not None:
                 self._read = [(b, pipeline.rig.bone_names[b]) for b in self.corrector.read]
         except Exception:
@@ -90,7 +89,7 @@ class LiveController:
         if obj is None:
             raise RuntimeError(f"armature {self.obj_name!r} no longer exists")
         if self.corrector is not None:
-            desired = getattr(pose, "desired", None)
+            desired = pose.desired
             pose.quats = self.corrector.correct(pose.quats, self._evaluated(obj), desired)
             if self.exact and desired is not None:  # the bake's own correction, from this close start
                 pose.quats = correct_for_evaluation(obj, pose.bone_names, pose.quats[None], pose.root_bone,
