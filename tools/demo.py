@@ -188,7 +188,7 @@ def run_job(job: Job, out: Path, args: argparse.Namespace, rigify_base: str | No
 
     result = Outcome(job)
     take = read_take(job)
-    name = job.take_path.stem if job.take_path.suffix else job.take_path.name
+    name = job.take_path.stem
     result.name = name
     stem = f"{name}__{job.rig}"
     t0 = time.perf_counter()
