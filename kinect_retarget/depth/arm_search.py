@@ -48,6 +48,7 @@ COVER_TOL = 0.08       # m: depth agreement for a covered evidence cell
 W_COVER = 0.8          # reward per sample on arm evidence, against a cost of 1 for a free-space violation
 ON_BODY_COST = 0.2     # a bone on the torso's own surface: an arm lying there would stand out in front of it
 W_PREVIOUS = 0.5       # per metre from the previous frame's elbow and hand
+MAX_HAND_STEP, W_JUMP = 0.25, 2.0   # m a searched hand moves in a frame for free; cost per metre beyond
 INSIDE_COST = 2.0      # an elbow or hand inside the torso
 TORSO_HALF_WIDTH = 0.1   # fraction of height: the trunk's half width seen from the front
 IN_FRONT = 0.06        # m in front of the chest's surface: an arm, not the chest
@@ -162,16 +163,19 @@ def _chain_cost(scorer, shoulder, u, v, l1, l2, lh, H):
     return cost, elbow, wrist, wrist + lh * v
 
 
-def search_arm(scorer: ArmScorer, shoulder, l1, l2, lh, H, prev_elbow=None, prev_hand=None):
-    """Best arm chain -> (elbow, wrist, hand, cost per sample)."""
+def search_arm(scorer: ArmScorer, shoulder, l1, l2, lh, H, prev_elbow=None, prev_hand=None, max_step=None):
+    """Best arm chain -> (elbow, wrist, hand, cost per sample). `max_step`: metres the hand may move from
+    `prev_hand` before each further metre costs W_JUMP (None: no limit)."""
     n_samples = len(UPPER_T) + len(FORE_T) + len(HAND_T)
 
     def chains(u, v):
         """Cost of every chain (u, v broadcast), with the previous pose's pull and the fold limit."""
         cost, elbow, wrist, hand = _chain_cost(scorer, shoulder, u, v, l1, l2, lh, H)
         if prev_elbow is not None and prev_hand is not None:
-            cost = cost + W_PREVIOUS * n_samples * (np.linalg.norm(elbow - prev_elbow, axis=-1)
-                                                    + np.linalg.norm(hand - prev_hand, axis=-1))
+            step = np.linalg.norm(hand - prev_hand, axis=-1)
+            cost = cost + W_PREVIOUS * n_samples * (np.linalg.norm(elbow - prev_elbow, axis=-1) + step)
+            if max_step is not None:
+                cost = cost + W_JUMP * n_samples * np.maximum(0.0, step - max_step)
         return cost + np.where(np.sum(u * v, -1) < FOLD_LIMIT, 10.0, 0.0), elbow, wrist, hand
 
     up = scorer.score([(shoulder + (l1 * DIRECTIONS)[:, None, :] * UPPER_T[:, None], UPPER_R * H)])
@@ -205,12 +209,15 @@ def best_elbow(scorer: ArmScorer, shoulder, candidates: np.ndarray, wrist, H, pr
     return candidates[i], float(cost[i])
 
 
-def fit_arms(pos, st, xyz, mask, proj, frame: TorsoFrame, H, prev=None, head_region=None) -> None:
+def fit_arms(pos, st, xyz, mask, proj, frame: TorsoFrame, H, prev=None, head_region=None,
+             settled: bool = False) -> None:
     """The arms of one fitted frame, in place (`pos`, `st`: the fit's 20 joints and states). A tracked hand
     keeps its wrist and gets the elbow its IK circle's depth backs; an arm whose hand is not a tracked
     extremity gets the pose that best explains the depth, reported inferred. Each arm explains its own
     cells: a tracked arm's are withheld, and when two searched arms claim the same cells the weaker looks
-    again without them (a hidden far arm must not borrow the near arm's)."""
+    again without them (a hidden far arm must not borrow the near arm's). Once the tracking has `settled`,
+    a searched hand does not jump more than MAX_HAND_STEP in a frame for free (a wrong early guess must
+    still be free to move)."""
     todo = [s for s in SIDES if st[J[f"Hand{s}"]] != TRACKED]
     evidence = arm_evidence(xyz, mask, pos, frame, head_region)
     lengths = (bm.UPPER_ARM * H, bm.FOREARM * H, bm.HAND * H)
@@ -230,7 +237,8 @@ def fit_arms(pos, st, xyz, mask, proj, frame: TorsoFrame, H, prev=None, head_reg
 
     def search(s, ev):
         pe, ph = (None, None) if prev is None else (prev[J[f"Elbow{s}"]], prev[J[f"Hand{s}"]])
-        return search_arm(ArmScorer(proj, ev, frame), pos[J[f"Shoulder{s}"]], *lengths, H, pe, ph)
+        return search_arm(ArmScorer(proj, ev, frame), pos[J[f"Shoulder{s}"]], *lengths, H, pe, ph,
+                          MAX_HAND_STEP if settled else None)
 
     found = {s: search(s, evidence) for s in todo}
     if len(todo) == 2:

@@ -49,6 +49,11 @@ class ConfidenceCheck:
         self._flag_age = np.full(20, RECOVERY_FRAMES + 1)
         self._frames = 0
 
+    @property
+    def settled(self) -> bool:
+        """Past the first frames after (re)acquisition."""
+        return self._frames >= WARMUP_FRAMES
+
     def predict(self) -> np.ndarray | None:
         if not self._history:
             return None

@@ -18,6 +18,7 @@ import numpy as np
 from ..core.skeletons import INFERRED, NOT_TRACKED, TRACKED
 from . import body_model_fit as bm
 from .arm_search import SIDES, J, TorsoFrame, fit_arms
+from .facing import chest_facing
 from .geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
 from .limb_ends import at_image_border, occluded_end
 from .two_bone import two_bone_candidates
@@ -38,6 +39,9 @@ W_MIDLINE = 1.0             # per metre a knee lies across the body's midline
 BEHIND_FREE, BEHIND_COST = 0.06, 0.5   # m behind the surface a joint may sit for free; cost per metre beyond
 SUPPORT_BEHIND = 0.08       # m behind the surface seen at its pixel an elbow/knee may sit and still be tracked
 TURNED_DEG = 45.0           # facing estimate turned this far: shoulders and hips overlap in depth, inferred
+SIDE_ON_DEG = 75.0           # chest facing this far from the sensor: side-on, the last facing is kept
+LATERAL_SMOOTHING = 0.5     # weight of the last frame's left-right direction (the chest's estimate is noisy)
+ON_LEG = 0.18               # m: a "hand" this near a fitted leg's bones is part of the leg (a raised knee)
 REACH_SLACK = 0.10          # m an extremity may lie beyond the limb's calibrated reach and still be its end
 
 
@@ -96,9 +100,10 @@ class Projector:
 
 def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states: np.ndarray | None,
                prev_lateral: np.ndarray | None, prev_centre: np.ndarray | None = None,
-               predicted: np.ndarray | None = None) -> FitResult | None:
+               predicted: np.ndarray | None = None, settled: bool = False) -> FitResult | None:
     """One frame's skeleton for the segmented person. `prev`/`prev_states`/`prev_lateral`: the last output;
-    `predicted`: where the motion so far says the joints are now (continuity for left/right labels)."""
+    `predicted`: where the motion so far says the joints are now (continuity for left/right labels);
+    `settled`: the person has been tracked past the first frames (their pose is no longer a first guess)."""
     rows, cols = np.nonzero(mask_full)
     r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
     # the person's bounding box of the tracker's grid (no coarser: coarser cells merge arms with the body)
@@ -135,16 +140,22 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
     facing = vt[2] if vt[2] @ view < 0 else -vt[2]  # the chest's normal, toward the sensor
     facing = _unit(facing - (facing @ axis) * axis)
     edge_on = bool(facing @ -view < 0.3)
-    if edge_on:  # seen nearly edge-on: the normal is unreliable, assume facing the sensor
-        facing = _unit(-view - (-view @ axis) * axis)
-    lat = _unit(np.cross(axis, facing))  # points to the performer's left
+    toward = _unit(-view - (-view @ axis) * axis)
+    chest = chest_facing(xyz, mask, centre - axis * calib.torso_patch_height * H, axis, H)
+    held = prev_lateral is not None and (chest is None or chest @ toward < np.cos(np.radians(SIDE_ON_DEG)))
+    if held:  # side-on the chest's direction is ambiguous: keep the last one until the turn goes on
+        lat = _unit(prev_lateral - (prev_lateral @ axis) * axis)
+    else:
+        # like the SDK, the performer is taken to face the sensor: a chest turned past side-on reads as
+        # its mirror image (a back looks like a front)
+        facing = chest if chest is not None else (toward if edge_on else facing)
+        lat = _unit(np.cross(axis, facing))  # points to the performer's left
+        if prev_lateral is not None and lat @ prev_lateral > np.cos(np.radians(45.0)):
+            lat = _unit(LATERAL_SMOOTHING * prev_lateral + (1 - LATERAL_SMOOTHING) * lat)
+            lat = _unit(lat - (lat @ axis) * axis)
+    facing = _unit(np.cross(lat, axis))
     # the chest's normal always faces the sensor, even side-on; the chest's visible width does not lie
     narrow = _visible_chest_width(xyz[mask], centre, axis, view, H) < SIDE_ON_WIDTH * H
-    if prev_lateral is not None:
-        if lat @ prev_lateral < 0:
-            lat = -lat
-        lat = _unit(0.5 * lat + 0.5 * prev_lateral)
-        lat = _unit(lat - (lat @ axis) * axis)
     inside = lambda name: view * bm.DEPTH_INSIDE[name]
     # --- extremities ---------------------------------------------------------------------------------
     extrema = geodesic_extrema(loose, d0, count=6, min_distance=0.15 * H, iterations=4)
@@ -199,7 +210,7 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
     rest = [e for e in cand if e is not head]
     feet = sorted([e for e in rest if e[3] < -0.33 * H], key=lambda e: -e[2])[:2]
     hands = sorted([e for e in rest if e not in feet and e[3] > -0.35 * H and e[2] > 0.22 * H],
-                   key=lambda e: -e[2])[:2]
+                   key=lambda e: -e[2])
     labels = []
     head_region = None
     if head is not None:
@@ -217,10 +228,13 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
         pos[J[f"Hip{s}"]] = hc_ + lat * sign * bm.HIP_HALF_WIDTH * H
         st[J[f"Shoulder{s}"]] = st[J[f"Hip{s}"]] = TRACKED
     # --- limbs ---------------------------------------------------------------------------------------
-    limb_specs = (("Shoulder", "Elbow", "Wrist", "Hand", bm.UPPER_ARM, bm.FOREARM, hands, 0.08, 0.08 + bm.HAND * H),
-                  ("Hip", "Knee", "Ankle", "Foot", bm.THIGH, bm.SHIN, feet, 0.07, 0.15))
+    # legs first: a knee raised in a hop sticks out like a hand, and the fitted knees say which it is
+    limb_specs = (("Hip", "Knee", "Ankle", "Foot", bm.THIGH, bm.SHIN, feet, 0.07, 0.15),
+                  ("Shoulder", "Elbow", "Wrist", "Hand", bm.UPPER_ARM, bm.FOREARM, hands, 0.08, 0.08 + bm.HAND * H))
     legs_clipped = 0
     for root, mid, end, tip, r1, r2, found, d_tip, d_end in limb_specs:
+        if root == "Shoulder":
+            found = [e for e in found if _leg_distance(pos, e[1]) > ON_LEG][:2]
         assign = _assign_sides(found, prev if predicted is None else predicted, prev_states, tip, lat, centre)
         for s in SIDES:
             e = assign.get(s)
@@ -298,7 +312,8 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
             st[J[f"{mid}{s}"]] = TRACKED if mid_ok else INFERRED
             st[J[f"{end}{s}"]] = st[J[f"{tip}{s}"]] = st_limb
     if ARM_SEARCH:
-        fit_arms(pos, st, xyz, mask, proj, TorsoFrame(centre, axis, lat, facing, pos, H), H, prev, head_region)
+        fit_arms(pos, st, xyz, mask, proj, TorsoFrame(centre, axis, lat, facing, pos, H), H, prev, head_region,
+                 settled)
     # without the head top or the shoulders the torso's place along its axis is a guess; seen more than
     # TURNED_DEG from the front, shoulders and hips overlap in depth: say so instead of claiming them
     if shift is None:
@@ -309,6 +324,17 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
         for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
             st[J[name]] = INFERRED
     return FitResult(pos, st, lat, labels, centre, proj, edge_on or narrow)
+
+
+def _leg_distance(pos, p) -> float:
+    """Distance from p to the nearest thigh or shin of the fitted legs."""
+    best = np.inf
+    for s in SIDES:
+        for a, b in (("Hip", "Knee"), ("Knee", "Ankle")):
+            a_, b_ = pos[J[f"{a}{s}"]], pos[J[f"{b}{s}"]]
+            t = np.clip((p - a_) @ (b_ - a_) / max((b_ - a_) @ (b_ - a_), 1e-9), 0.0, 1.0)
+            best = min(best, float(np.linalg.norm(a_ + t * (b_ - a_) - p)))
+    return best
 
 
 def _visible_chest_width(pts, centre, axis, view, H):
@@ -389,6 +415,12 @@ def _assign_sides(found, prev, prev_states, tip, lat, centre) -> dict:
             if abs(a - b) < 0.05:
                 return dict(zip(SIDES, found if side_a > 0 else found[::-1]))
             return dict(zip(SIDES, found if a <= b else found[::-1]))
+        for s, other in (SIDES, SIDES[::-1]):
+            if seen[s]:  # one side seen: the candidate nearest its hand/foot is it, the other is the other
+                near = [np.linalg.norm(f[1] - prev[J[f"{tip}{s}"]]) for f in found]
+                k = int(np.argmin(near))
+                if near[k] < CONTINUITY_RADIUS:
+                    return {s: found[k], other: found[1 - k]}
         return dict(zip(SIDES, found if found[0][4] >= found[1][4] else found[::-1]))
     f = found[0]
     near = {s: np.linalg.norm(f[1] - prev[J[f"{tip}{s}"]]) for s in SIDES if seen[s]}

@@ -98,7 +98,8 @@ class SkeletonTracker:
             return self._none("no person in view")
         last = self.last_good
         fit = fit_person(grid, person.mask, up, self.calibration, self._prev, self._prev_states, self._lateral,
-                         None if last is None else last.torso_centre, self.confidence.predict())
+                         None if last is None else last.torso_centre, self.confidence.predict(),
+                         self.confidence.settled)
         if fit is None or not np.all(np.isfinite(fit.positions)):
             self._lose(ts)
             return self._none("person found but no skeleton fitted")

@@ -55,9 +55,9 @@ def test_search_alone_finds_the_arm(hand_on_face, monkeypatch):
     calls = []
     real = arm_search.search_arm
 
-    def spy(scorer, shoulder, l1, l2, lh, H, prev_elbow=None, prev_hand=None):
+    def spy(scorer, shoulder, l1, l2, lh, H, prev_elbow=None, prev_hand=None, max_step=None):
         calls.append((scorer, shoulder, l1, l2, lh, H))
-        return real(scorer, shoulder, l1, l2, lh, H, prev_elbow, prev_hand)
+        return real(scorer, shoulder, l1, l2, lh, H, prev_elbow, prev_hand, max_step)
 
     monkeypatch.setattr(arm_search, "search_arm", spy)
     _track(hand_on_face)
