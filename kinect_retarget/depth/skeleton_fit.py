@@ -41,7 +41,6 @@ SUPPORT_BEHIND = 0.08       # m behind the surface seen at its pixel an elbow/kn
 TURNED_DEG = 45.0           # facing estimate turned this far: shoulders and hips overlap in depth, inferred
 SIDE_ON_DEG = 75.0           # chest facing this far from the sensor: side-on, the last facing is kept
 LATERAL_SMOOTHING = 0.5     # weight of the last frame's left-right direction (the chest's estimate is noisy)
-ON_LEG = 0.18               # m: a "hand" this near a fitted leg's bones is part of the leg (a raised knee)
 REACH_SLACK = 0.10          # m an extremity may lie beyond the limb's calibrated reach and still be its end
 
 
@@ -210,7 +209,7 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
     rest = [e for e in cand if e is not head]
     feet = sorted([e for e in rest if e[3] < -0.33 * H], key=lambda e: -e[2])[:2]
     hands = sorted([e for e in rest if e not in feet and e[3] > -0.35 * H and e[2] > 0.22 * H],
-                   key=lambda e: -e[2])
+                   key=lambda e: -e[2])[:2]
     labels = []
     head_region = None
     if head is not None:
@@ -228,13 +227,10 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
         pos[J[f"Hip{s}"]] = hc_ + lat * sign * bm.HIP_HALF_WIDTH * H
         st[J[f"Shoulder{s}"]] = st[J[f"Hip{s}"]] = TRACKED
     # --- limbs ---------------------------------------------------------------------------------------
-    # legs first: a knee raised in a hop sticks out like a hand, and the fitted knees say which it is
-    limb_specs = (("Hip", "Knee", "Ankle", "Foot", bm.THIGH, bm.SHIN, feet, 0.07, 0.15),
-                  ("Shoulder", "Elbow", "Wrist", "Hand", bm.UPPER_ARM, bm.FOREARM, hands, 0.08, 0.08 + bm.HAND * H))
+    limb_specs = (("Shoulder", "Elbow", "Wrist", "Hand", bm.UPPER_ARM, bm.FOREARM, hands, 0.08, 0.08 + bm.HAND * H),
+                  ("Hip", "Knee", "Ankle", "Foot", bm.THIGH, bm.SHIN, feet, 0.07, 0.15))
     legs_clipped = 0
     for root, mid, end, tip, r1, r2, found, d_tip, d_end in limb_specs:
-        if root == "Shoulder":
-            found = [e for e in found if _leg_distance(pos, e[1]) > ON_LEG][:2]
         assign = _assign_sides(found, prev if predicted is None else predicted, prev_states, tip, lat, centre)
         for s in SIDES:
             e = assign.get(s)
@@ -324,17 +320,6 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
         for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
             st[J[name]] = INFERRED
     return FitResult(pos, st, lat, labels, centre, proj, edge_on or narrow)
-
-
-def _leg_distance(pos, p) -> float:
-    """Distance from p to the nearest thigh or shin of the fitted legs."""
-    best = np.inf
-    for s in SIDES:
-        for a, b in (("Hip", "Knee"), ("Knee", "Ankle")):
-            a_, b_ = pos[J[f"{a}{s}"]], pos[J[f"{b}{s}"]]
-            t = np.clip((p - a_) @ (b_ - a_) / max((b_ - a_) @ (b_ - a_), 1e-9), 0.0, 1.0)
-            best = min(best, float(np.linalg.norm(a_ + t * (b_ - a_) - p)))
-    return best
 
 
 def _visible_chest_width(pts, centre, axis, view, H):
