@@ -131,7 +131,8 @@ def main() -> None:
             print(f"issue 5's motions ({', '.join(n for n in ISSUE_MOTIONS if n in named)}): mean error "
                   f"{np.mean([x.mean_error for x in issue]) * 100:.1f} cm (goal <= 8; each "
                   + " / ".join(f"{x.mean_error * 100:.1f}" for x in issue) + ") | within 15 cm or flagged "
-                  + " / ".join(f"{x.within_or_flagged * 100:.1f}" for x in issue) + " % | swaps >3 frames "
+                  + " / ".join(f"{x.within_or_flagged * 100:.1f}" for x in issue) + " % (tracked yet beyond 15 cm: "
+                  + " / ".join(str(x.wrong_tracked) for x in issue) + " samples) | swaps >3 frames "
                   + " / ".join(str(x.swaps_over_3) for x in issue), flush=True)
         print(f"all motions (with the turns): mean error {np.mean(errs) * 100:.1f} cm, frontal frames "
               f"{np.mean(frontal_errs) * 100:.1f} cm")

@@ -21,6 +21,7 @@ class Score:
     coverage: float              # fraction of present frames with a skeleton
     nan_frames: int
     flagged: float = 0.0         # fraction of joint samples reported inferred/untracked (honesty has a price)
+    wrong_tracked: int = 0       # joint samples reported TRACKED yet beyond 15 cm (the goal is none)
 
 
 def facing_angle(gt: np.ndarray) -> np.ndarray:
@@ -59,4 +60,4 @@ def score(positions: np.ndarray, states: np.ndarray, gt: np.ndarray, present: np
                  float(ok.mean()) if ok.size else 0.0,
                  float(e[s == TRACKED].mean()) if np.any(s == TRACKED) else float("nan"),
                  max(runs, default=0), sum(r > 3 for r in runs), float(has.sum() / max(present.sum(), 1)),
-                 nan_frames, float(np.mean(s != TRACKED)) if s.size else 0.0)
+                 nan_frames, float(np.mean(s != TRACKED)) if s.size else 0.0, int(np.sum(~ok)))

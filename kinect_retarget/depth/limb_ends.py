@@ -5,6 +5,7 @@ from __future__ import annotations
 
 BORDER_CELLS = 2       # an extremity this close to the image's edge may be where the limb leaves it
 OCCLUDER_GAP = 0.06    # m nearer than the extremity for a neighbour to count as hiding the limb
+OCCLUDER_RADIUS = 4    # cells around the extremity searched for a nearer surface (about 5 cm at 1.7 m)
 
 
 def at_image_border(grid, rc) -> bool:
@@ -14,8 +15,9 @@ def at_image_border(grid, rc) -> bool:
     return bool(r >= h - 1 - BORDER_CELLS or c <= BORDER_CELLS or c >= w - 1 - BORDER_CELLS or r <= BORDER_CELLS)
 
 
-def occluded_end(xyz, mask, rc, radius: int = 2) -> bool:
-    """The surface next to this extremity is nearer the sensor: the limb goes on behind it."""
+def occluded_end(xyz, mask, rc, radius: int = OCCLUDER_RADIUS) -> bool:
+    """The surface next to this extremity is nearer the sensor: the limb goes on behind it, or into it (a
+    hand resting on a thigh merges with it, and the surface's extremity is then the wrist)."""
     r, c = rc
     h, w = mask.shape
     win = (slice(max(r - radius, 0), min(r + radius + 1, h)), slice(max(c - radius, 0), min(c + radius + 1, w)))
