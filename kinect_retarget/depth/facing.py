@@ -45,14 +45,19 @@ def chest_facing(xyz: np.ndarray, mask: np.ndarray, floor_point: np.ndarray, axi
     """Unit facing direction (perpendicular to `axis`) of the chest, or None when too little of it is seen.
 
     `floor_point`: where the torso axis meets the floor; `height`: the performer's standing height."""
-    n, ok = surface_normals(xyz, mask)
     rel = xyz - floor_point
     along = rel @ axis
     across = np.linalg.norm(rel - along[..., None] * axis, axis=-1)
-    sel = ok & (along > CHEST_BAND[0] * height) & (along < CHEST_BAND[1] * height) & (across < CHEST_RADIUS)
+    sel = mask & (along > CHEST_BAND[0] * height) & (along < CHEST_BAND[1] * height) & (across < CHEST_RADIUS)
     if sel.sum() < MIN_CELLS:
         return None
-    normals, points = n[sel], xyz[sel]
+    rows, cols = np.nonzero(sel)   # normals only around the chest (a sixth of the person's cells)
+    box = (slice(max(rows.min() - 1, 0), rows.max() + 2), slice(max(cols.min() - 1, 0), cols.max() + 2))
+    n, ok = surface_normals(xyz[box], mask[box])
+    sel = sel[box] & ok
+    if sel.sum() < MIN_CELLS:
+        return None
+    normals, points = n[sel], xyz[box][sel]
     toward = unit(-np.mean(points, axis=0))
     e1 = unit(toward - (toward @ axis) * axis)          # toward the camera, across the axis
     e2 = np.cross(axis, e1)
