@@ -87,7 +87,7 @@ def geodesic_extrema(graph: SurfaceGraph, d0: np.ndarray, count: int = 6, min_di
     Returns [(row, col, geodesic distance from the torso)] for extrema at least `min_distance` away."""
     out = []
     d = d0.copy()
-    for _ in range(count):
+    for i in range(count):
         finite = np.where(np.isfinite(d), d, -1.0)
         k = int(np.argmax(finite))
         if finite.flat[k] < min_distance * 0.5:
@@ -95,7 +95,8 @@ def geodesic_extrema(graph: SurfaceGraph, d0: np.ndarray, count: int = 6, min_di
         r, c = divmod(k, d.shape[1])
         if d0[r, c] >= min_distance:
             out.append((r, c, float(d0[r, c])))
-        d = graph.distances(np.array([[r, c]]), init=d, iterations=iterations)
+        if i < count - 1:   # the last extremum's distances would never be read
+            d = graph.distances(np.array([[r, c]]), init=d, iterations=iterations)
     return out
 
 

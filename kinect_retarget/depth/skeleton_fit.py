@@ -1,8 +1,8 @@
 """Fit the 20-joint Kinect v1 skeleton to one segmented person (numpy only).
 
-Per frame: a torso patch (geodesic disc around the previous spine) gives the torso frame; geodesic
-extrema give head, hand and foot candidates; level-set centroids (paper 003) near each extremity give
-hand/wrist and foot/ankle; elbows and knees come from two-bone inverse kinematics with the calibrated
+Per frame: a torso patch (geodesic disc around the previous spine) gives the torso frame, the chest's
+surface normals its facing (facing.py); geodesic extrema give head, hand and foot candidates; level-set
+centroids (paper 003) near each extremity give hand/wrist and foot/ankle; elbows and knees come from two-bone inverse kinematics with the calibrated
 bone lengths, choosing on the IK circle the point that best agrees with the depth image (projective
 check), the level-set centroid and the previous frame. An extremity at the image's edge or beside a nearer
 surface is where the view of the limb ends (limb_ends). Arms are then fitted against the depth
@@ -153,7 +153,7 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
             lat = _unit(LATERAL_SMOOTHING * prev_lateral + (1 - LATERAL_SMOOTHING) * lat)
             lat = _unit(lat - (lat @ axis) * axis)
     facing = _unit(np.cross(lat, axis))
-    # the chest's normal always faces the sensor, even side-on; the chest's visible width does not lie
+    # the torso plane's normal always faces the sensor, even side-on; the chest's visible width does not lie
     narrow = _visible_chest_width(xyz[mask], centre, axis, view, H) < SIDE_ON_WIDTH * H
     inside = lambda name: view * bm.DEPTH_INSIDE[name]
     # --- extremities ---------------------------------------------------------------------------------
