@@ -5,7 +5,8 @@ ever sees normals within 90 degrees of itself, so a torso turned 60 degrees show
 and its side (normals near -30), and the mean lands near 20. The chest is flatter than the torso's sides,
 so its front's normals are the densest direction on the surface: the mode of the normals' directions,
 each cell weighted by the surface area it stands for (1 / cos of the viewing angle, undoing foreshortening),
-is the chest's facing. On rendered turns it is within 2-5 degrees of the truth where the mean is 30 off.
+is the chest's facing. On the rendered hop's turns (45-63 degrees) the tracker's facing is within 6 degrees
+of the truth, where the mean normal read 12-35.
 """
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ CHEST_RADIUS = 0.25           # m from the torso axis: the trunk, not an arm han
 MAX_STEP = 0.15               # m between a cell's neighbours: more is a depth edge, not surface
 KERNEL_DEG = 8.0              # smoothing of the histogram of directions
 REFINE_DEG = 10.0             # window of the mean-shift refinement around the histogram's peak
-MIN_CELLS = 30
+MIN_CELLS = 30                # fewer chest cells (held far off, mostly hidden): no answer
 _BINS = np.arange(-90.0, 90.5, 2.0)
 
 

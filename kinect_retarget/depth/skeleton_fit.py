@@ -2,12 +2,13 @@
 
 Per frame: a torso patch (geodesic disc around the previous spine) gives the torso frame, the chest's
 surface normals its facing (facing.py); geodesic extrema give head, hand and foot candidates; level-set
-centroids (paper 003) near each extremity give hand/wrist and foot/ankle; elbows and knees come from two-bone inverse kinematics with the calibrated
-bone lengths, choosing on the IK circle the point that best agrees with the depth image (projective
-check), the level-set centroid and the previous frame. An extremity at the image's edge or beside a nearer
-surface is where the view of the limb ends (limb_ends). Arms are then fitted against the depth
-(arm_search): the elbow of a tracked hand, and the whole of an arm whose hand is not a tracked extremity.
-Legs without evidence keep their previous pose relative to the torso; both are reported inferred.
+centroids (paper 003) near each extremity give hand/wrist and foot/ankle; elbows and knees come from
+two-bone inverse kinematics with the calibrated bone lengths, choosing on the IK circle the point that best
+agrees with the depth image (projective check), the level-set centroid and the previous frame. An
+extremity at the image's edge or beside a nearer surface is where the view of the limb ends (limb_ends).
+Arms are then fitted against the depth (arm_search): the elbow of a tracked hand, and the whole of an arm
+whose hand is not a tracked extremity. Legs without evidence keep their previous pose relative to the
+torso; both are reported inferred.
 """
 from __future__ import annotations
 
@@ -21,6 +22,7 @@ from .arm_search import SIDES, J, TorsoFrame, fit_arms
 from .facing import chest_facing
 from .geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
 from .limb_ends import at_image_border, occluded_end
+from .sides import assign_sides
 from .two_bone import two_bone_candidates
 from .two_bone import unit as _unit
 
@@ -31,7 +33,6 @@ MAX_SIDE_LEAN_DEG = 20.0    # sideways component of a lean beyond which the "hea
 MAX_LEAN_DEG = 60.0         # a "head" farther than this from upright is taken for something else
 AXIS_GRAVITY_WEIGHT = 0.75  # torso axis = this blend of gravity's up and the torso patch's long axis
 SIDE_ON_WIDTH = 0.165       # visible chest width / height below which the torso is taken as seen side-on
-CONTINUITY_RADIUS = 0.25    # m a lone hand/foot may move from a tracked one and still be taken for it
 HEAD_REGION = 0.12          # fraction of height along the surface from the head's extremum: head and neck
 ARM_SEARCH = True           # arms without a hand extremity: search poses against the depth (arm_search)
 TRUNCATED_EXTEND = 0.5      # a limb leaving the image continues this fraction of its remaining reach
@@ -39,7 +40,7 @@ W_MIDLINE = 1.0             # per metre a knee lies across the body's midline
 BEHIND_FREE, BEHIND_COST = 0.06, 0.5   # m behind the surface a joint may sit for free; cost per metre beyond
 SUPPORT_BEHIND = 0.08       # m behind the surface seen at its pixel an elbow/knee may sit and still be tracked
 TURNED_DEG = 45.0           # facing estimate turned this far: shoulders and hips overlap in depth, inferred
-SIDE_ON_DEG = 75.0           # chest facing this far from the sensor: side-on, the last facing is kept
+SIDE_ON_DEG = 75.0          # chest facing this far from the sensor: side-on, the last facing is kept
 LATERAL_SMOOTHING = 0.5     # weight of the last frame's left-right direction (the chest's estimate is noisy)
 REACH_SLACK = 0.10          # m an extremity may lie beyond the limb's calibrated reach and still be its end
 
@@ -149,6 +150,7 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
         # its mirror image (a back looks like a front)
         facing = chest if chest is not None else (toward if edge_on else facing)
         lat = _unit(np.cross(axis, facing))  # points to the performer's left
+        # (a reading more than 45 degrees from the last is the mirror image flipping over: taken as it is)
         if prev_lateral is not None and lat @ prev_lateral > np.cos(np.radians(45.0)):
             lat = _unit(LATERAL_SMOOTHING * prev_lateral + (1 - LATERAL_SMOOTHING) * lat)
             lat = _unit(lat - (lat @ axis) * axis)
@@ -231,7 +233,7 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
                   ("Hip", "Knee", "Ankle", "Foot", bm.THIGH, bm.SHIN, feet, 0.07, 0.15))
     legs_clipped = 0
     for root, mid, end, tip, r1, r2, found, d_tip, d_end in limb_specs:
-        assign = _assign_sides(found, prev if predicted is None else predicted, prev_states, tip, lat, centre)
+        assign = assign_sides(found, prev if predicted is None else predicted, prev_states, tip)
         for s in SIDES:
             e = assign.get(s)
             a = pos[J[f"{root}{s}"]]
@@ -376,39 +378,3 @@ def _carry(prev, s, end, tip, root_pos, axis, pos, root):
         return e, e - axis * 0.08, None
     e = root_pos - axis * 0.46
     return e, e - axis * 0.04 + _unit(-root_pos) * 0.08, None
-
-
-def _assign_sides(found, prev, prev_states, tip, lat, centre) -> dict:
-    """Give each found extremity a side: feet well apart by body side (feet do not cross), otherwise by
-    continuity with `prev` (the caller passes where the motion predicts the joints now), counting only
-    sides whose hand/foot was tracked, else by body side."""
-    if not found:
-        return {}
-    if tip == "Foot" and len(found) == 2 and found[0][4] * found[1][4] < 0 \
-            and abs(found[0][4] - found[1][4]) > 0.25:
-        return dict(zip(SIDES, found if found[0][4] > 0 else found[::-1]))
-    # only a previous position that rested on evidence says where a side's hand/foot is now
-    seen = {s: prev is not None and prev_states is not None and prev_states[J[f"{tip}{s}"]] == TRACKED
-            for s in SIDES}
-    have_prev = all(seen.values())
-    if len(found) == 2:
-        if have_prev:
-            a = sum(np.linalg.norm(f[1] - prev[J[f"{tip}{s}"]]) for f, s in zip(found, SIDES))
-            b = sum(np.linalg.norm(f[1] - prev[J[f"{tip}{s}"]]) for f, s in zip(found[::-1], SIDES))
-            # body side wins when continuity is ambiguous (both hands near each other)
-            side_a = (found[0][4] - found[1][4])
-            if abs(a - b) < 0.05:
-                return dict(zip(SIDES, found if side_a > 0 else found[::-1]))
-            return dict(zip(SIDES, found if a <= b else found[::-1]))
-        for s, other in (SIDES, SIDES[::-1]):
-            if seen[s]:  # one side seen: the candidate nearest its hand/foot is it, the other is the other
-                near = [np.linalg.norm(f[1] - prev[J[f"{tip}{s}"]]) for f in found]
-                k = int(np.argmin(near))
-                if near[k] < CONTINUITY_RADIUS:
-                    return {s: found[k], other: found[1 - k]}
-        return dict(zip(SIDES, found if found[0][4] >= found[1][4] else found[::-1]))
-    f = found[0]
-    near = {s: np.linalg.norm(f[1] - prev[J[f"{tip}{s}"]]) for s in SIDES if seen[s]}
-    if near and min(near.values()) < CONTINUITY_RADIUS:
-        return {min(near, key=near.get): f}
-    return {"Left" if f[4] >= 0 else "Right": f}

@@ -1,10 +1,10 @@
-"""Left/right labels of hand and foot candidates (skeleton_fit._assign_sides)."""
+"""Left/right labels of hand and foot candidates (depth.sides)."""
 from __future__ import annotations
 
 import numpy as np
 
 from kinect_retarget.core.skeletons import INFERRED, KINECT_V1, TRACKED
-from kinect_retarget.depth.skeleton_fit import _assign_sides
+from kinect_retarget.depth.sides import assign_sides
 
 J = KINECT_V1.index
 LAT = np.array([-1.0, 0.0, 0.0])   # the performer's left, seen from the sensor: the image's right
@@ -27,14 +27,14 @@ def test_one_seen_hand_keeps_its_candidate():
     the left hand; the right hand seen last frame says it is the right one."""
     right_hand, knee = _cand([0.50, 0.30, 1.58]), _cand([0.64, -0.18, 1.72])
     pos, st = _prev([0.21, -0.10, 1.57], [0.64, 0.41, 1.66], INFERRED, TRACKED)
-    by_body = _assign_sides([right_hand, knee], None, None, "Hand", LAT, np.zeros(3))
+    by_body = assign_sides([right_hand, knee], None, None, "Hand")
     assert by_body["Left"] is right_hand
-    got = _assign_sides([right_hand, knee], pos, st, "Hand", LAT, np.zeros(3))
+    got = assign_sides([right_hand, knee], pos, st, "Hand")
     assert got["Right"] is right_hand and got["Left"] is knee
 
 
 def test_one_seen_hand_far_from_both_falls_back_to_body_side():
     a, b = _cand([-0.3, 0.0, 2.0]), _cand([0.3, 0.0, 2.0])
     pos, st = _prev([0.0, 0.0, 2.0], [0.0, 1.0, 2.0], INFERRED, TRACKED)   # 1 m from both candidates
-    got = _assign_sides([a, b], pos, st, "Hand", LAT, np.zeros(3))
+    got = assign_sides([a, b], pos, st, "Hand")
     assert got["Left"] is a and got["Right"] is b
