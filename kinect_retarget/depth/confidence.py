@@ -48,11 +48,17 @@ class ConfidenceCheck:
         self._history: list[np.ndarray] = []
         self._flag_age = np.full(20, RECOVERY_FRAMES + 1)
         self._frames = 0
+        self._facing_frames = 0   # frames in a row the fit faced the sensor (not turned, not side-on)
 
     @property
     def settled(self) -> bool:
         """Past the first frames after (re)acquisition."""
         return self._frames >= WARMUP_FRAMES
+
+    @property
+    def facing_steady(self) -> bool:
+        """Settled, and facing the sensor for as long: a turn's mirror image has left the history."""
+        return self._facing_frames >= WARMUP_FRAMES
 
     def predict(self) -> np.ndarray | None:
         if not self._history:
@@ -83,6 +89,8 @@ class ConfidenceCheck:
             bad = np.cumsum(doubt[chain]) > 0   # (an elbow the fit merely inferred leaves the hand its own evidence)
             doubt[chain] |= bad & (st[chain] == TRACKED)
         self._frames += 1
+        turned = getattr(fit, "turned", False) or getattr(fit, "edge_on", False)
+        self._facing_frames = 0 if turned else self._facing_frames + 1
         if self._frames <= WARMUP_FRAMES:   # a person just found: limbs settle over the first frames
             doubt[LIMB] = True
         self._flag_age = np.where(doubt, 0, self._flag_age + 1)

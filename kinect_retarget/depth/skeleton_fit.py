@@ -54,6 +54,7 @@ class FitResult:
     torso_centre: np.ndarray | None = None
     projector: "Projector | None" = None          # for the confidence checks after the fit
     edge_on: bool = False                          # the chest's normal was unusable (seen side-on)
+    turned: bool = False                           # facing more than TURNED_DEG away from the sensor
 
 
 def _nearest_cell(xyz: np.ndarray, mask: np.ndarray, p: np.ndarray) -> tuple[int, int] | None:
@@ -100,10 +101,12 @@ class Projector:
 
 def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states: np.ndarray | None,
                prev_lateral: np.ndarray | None, prev_centre: np.ndarray | None = None,
-               predicted: np.ndarray | None = None, settled: bool = False) -> FitResult | None:
+               predicted: np.ndarray | None = None, settled: bool = False,
+               facing_steady: bool = False) -> FitResult | None:
     """One frame's skeleton for the segmented person. `prev`/`prev_states`/`prev_lateral`: the last output;
     `predicted`: where the motion so far says the joints are now (continuity for left/right labels);
-    `settled`: the person has been tracked past the first frames (their pose is no longer a first guess)."""
+    `settled`: the person has been tracked past the first frames (their pose is no longer a first guess);
+    `facing_steady`: and has faced the sensor for those frames (no turn's mirror image left in the history)."""
     rows, cols = np.nonzero(mask_full)
     r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
     # the person's bounding box of the tracker's grid (no coarser: coarser cells merge arms with the body)
@@ -311,17 +314,18 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
             st[J[f"{end}{s}"]] = st[J[f"{tip}{s}"]] = st_limb
     if ARM_SEARCH:
         fit_arms(pos, st, xyz, mask, proj, TorsoFrame(centre, axis, lat, facing, pos, H), H, prev, head_region,
-                 settled)
+                 settled, facing_steady)
     # without the head top or the shoulders the torso's place along its axis is a guess; seen more than
     # TURNED_DEG from the front, shoulders and hips overlap in depth: say so instead of claiming them
     if shift is None:
         st[[J["HipCenter"], J["Spine"], J["ShoulderCenter"]]] = INFERRED
     if legs_clipped == 2:   # both legs leave the image (the SDK's "clipped bottom"): nothing checks the hips
         st[[J["HipCenter"], J["HipLeft"], J["HipRight"]]] = INFERRED
-    if facing @ -view < np.cos(np.radians(TURNED_DEG)):
+    turned = bool(facing @ -view < np.cos(np.radians(TURNED_DEG)))
+    if turned:
         for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
             st[J[name]] = INFERRED
-    return FitResult(pos, st, lat, labels, centre, proj, edge_on or narrow)
+    return FitResult(pos, st, lat, labels, centre, proj, edge_on or narrow, turned)
 
 
 def _visible_chest_width(pts, centre, axis, view, H):

@@ -99,7 +99,7 @@ class SkeletonTracker:
         last = self.last_good
         fit = fit_person(grid, person.mask, up, self.calibration, self._prev, self._prev_states, self._lateral,
                          None if last is None else last.torso_centre, self.confidence.predict(),
-                         self.confidence.settled)
+                         self.confidence.settled, self.confidence.facing_steady)
         if fit is None or not np.all(np.isfinite(fit.positions)):
             self._lose(ts)
             return self._none("person found but no skeleton fitted")

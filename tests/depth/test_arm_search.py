@@ -117,3 +117,21 @@ def test_the_head_is_not_arm_evidence(hand_on_face, monkeypatch):
     g = hand_on_face.joints[-1]
     near_hand = mask & (np.linalg.norm(xyz - g[HAND_R], axis=-1) < 0.08)
     assert np.mean(ev[near_hand]) > 0.3     # the hand held to the face still counts for its arm
+
+
+def test_well_explained_arms_of_a_performer_facing_the_sensor_are_tracked(shared_data, monkeypatch):
+    """Walking toward the sensor with the hands hanging (no extremity): once the tracking is steady, the
+    search's elbows and wrists that the surface shows are reported tracked, and they are right."""
+    from kinect_retarget.depth.synthetic import Scenario, render_sequence
+    seq = render_sequence(str(shared_data / "mocap_bvh" / "131_02.bvh"), str(shared_data / "meshes" / "makehuman"),
+                          Scenario(seed=5), start=0, frames=16)
+    arm = [KINECT_V1.index(f"{j}{s}") for j in ("Elbow", "Wrist") for s in ("Left", "Right")]
+
+    def tracked_arm_errors():
+        return [float(np.linalg.norm(pos[j] - g[j])) for (pos, st), g in zip(_track(seq), seq.joints)
+                for j in arm if st[j] == TRACKED]
+
+    promoted = tracked_arm_errors()
+    assert len(promoted) >= 8 and max(promoted) < 0.15
+    monkeypatch.setattr(arm_search, "SEARCH_TRACKED_COST", -np.inf)   # the rule off: searched arms inferred
+    assert len(tracked_arm_errors()) < len(promoted)

@@ -84,3 +84,21 @@ def test_rendered_hop_is_within_15cm_or_flagged_without_flagging_everything(rend
     sc = score(take.positions, take.states, seq.joints, seq.present)
     assert sc.within_or_flagged >= 0.97, f"{sc.within_or_flagged:.3f}"
     assert sc.flagged < 0.6, f"{sc.flagged:.3f}"
+
+
+def test_a_turn_unsteadies_the_facing_until_it_has_faced_the_sensor_again(rng):
+    pose = rng.normal(0.0, 0.3, (20, 3)) + [0.0, 0.0, 2.5]
+    chk, tracked = ConfidenceCheck(), np.full(20, TRACKED, np.uint8)
+    facing = SimpleNamespace(projector=None, edge_on=False, turned=False, extrema=ALL_FOUND)
+    turned = SimpleNamespace(projector=None, edge_on=False, turned=True, extrema=ALL_FOUND)
+    for _ in range(WARMUP_FRAMES):
+        assert not chk.facing_steady
+        chk.assess(pose, tracked, facing)
+    assert chk.settled and chk.facing_steady
+    chk.assess(pose, tracked, turned)                 # turned away: a mirror image may be in the history
+    assert chk.settled and not chk.facing_steady
+    for _ in range(WARMUP_FRAMES - 1):
+        chk.assess(pose, tracked, facing)
+        assert not chk.facing_steady
+    chk.assess(pose, tracked, facing)
+    assert chk.facing_steady
