@@ -39,7 +39,8 @@ OFF_SURFACE = 0.2        # Projector.cost at or above this: off the person's sil
 
 
 class ConfidenceCheck:
-    """Per-tracker state (the last two output poses, recent flags) and the per-frame demotion."""
+    """Per-tracker state (the last two output poses, recent flags, how long the performer has been in view
+    and facing the sensor) and the per-frame demotion."""
 
     def __init__(self):
         self.reset()
