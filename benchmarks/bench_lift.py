@@ -51,9 +51,8 @@ def mocap_take(path: Path, rate: float = 30.0, max_s: float | None = None) -> Ta
     return take.slice(frames)
 
 
-def evaluate(truth: np.ndarray, tracks: Tracks2D, lengths: np.ndarray | float, method: dict) -> dict:
-    """lengths: calibrated (J,) metres, or a height in metres (anthropometric, self-calibrated)."""
-    size = dict(height_m=float(lengths)) if np.ndim(lengths) == 0 else dict(lengths=lengths)
+def evaluate(truth: np.ndarray, tracks: Tracks2D, size: dict, method: dict) -> dict:
+    """size: LiftSettings' dict(lengths=calibrated (J,) metres) or dict(height_m=...) (anthropometric)."""
     st = LiftSettings(**size, focal_px=FOCAL if method["focal"] else None,
                       signs=method["signs"], scale=method["scale"])
     t0 = time.perf_counter()
@@ -74,8 +73,8 @@ def bench_mocap(files: list[str], noise_px: float, max_s: float | None, anthropo
     for name in files:
         take = mocap_take(DATA / "mocap_bvh" / name, max_s=max_s)
         lengths = lengths_from_take(take)
-        if anthropometric:  # only the performer's height is known
-            lengths = standing_height(lengths)
+        # anthropometric: only the performer's height is known
+        size = dict(height_m=standing_height(lengths)) if anthropometric else dict(lengths=lengths)
         pivot = take.positions[:, 0].mean(axis=0)
         for az, el in VIEWS:
             truth = view_points(take.positions, az, el, 4.5, pivot)
@@ -83,7 +82,7 @@ def bench_mocap(files: list[str], noise_px: float, max_s: float | None, anthropo
             tracks = tracks_from_take(vt, cam, IMAGE, noise_px, rng)
             line = []
             for m, spec in METHODS.items():
-                r = evaluate(truth, tracks, lengths, spec)
+                r = evaluate(truth, tracks, size, spec)
                 rows[m].append(r)
                 line.append(f"{r['pa']:5.0f}/{r['flip']:.2f}")
             print(f"  {name:10s} az {az:4d} el {el:2d}: " + "  ".join(line))

@@ -5,8 +5,6 @@ import json
 import os
 import sys
 
-from .lift.tracks2d import LiftError
-
 
 def add_parsers(sub) -> None:
     p = sub.add_parser("lift", help="lift 2D joint tracks (OpenPose, COCO, Blender clip tracks) to a 3D take")
@@ -38,7 +36,7 @@ def add_parsers(sub) -> None:
 
 def run_lift(args) -> int:
     from .lift import LiftSettings, detect_2d_format, lift, read_2d
-    from .lift.bones import lengths_from_take, lengths_scaled_to_height
+    from .lift.bones import DEFAULT_HEIGHT_M, lengths_from_take, lengths_scaled_to_height
     from .takes import krtake, load_take
 
     fmt = detect_2d_format(args.input) if args.format == "auto" else args.format
@@ -55,8 +53,8 @@ def run_lift(args) -> int:
         lengths = lengths_from_take(load_take(args.calibrate))
         if args.height is not None:  # an explicit height rescales the calibrated proportions
             lengths = lengths_scaled_to_height(lengths, args.height)
-    res = lift(tracks, LiftSettings(height_m=args.height or 1.70, lengths=lengths, focal_px=focal, image_size=size,
-                                    signs=args.signs))
+    res = lift(tracks, LiftSettings(height_m=args.height or DEFAULT_HEIGHT_M, lengths=lengths, focal_px=focal,
+                                    image_size=size, signs=args.signs))
     res.take.metadata["name"] = os.path.splitext(os.path.basename(os.path.normpath(args.out)))[0]
     krtake.write(args.out, res.take)
     for msg in res.problems:
@@ -68,12 +66,12 @@ def run_lift(args) -> int:
 
 
 def run_track(args) -> int:
-    from .lift.frames import list_frames, load_frame
+    from .lift.frames import NATIVE, list_frames, load_frame
     from .lift.tracker import JointTracker, TrackerSettings, read_init, write_keypoints
 
     paths = list_frames(args.frames)
     loader = load_frame
-    if any(not p.lower().endswith((".ppm", ".pgm", ".pnm", ".npy")) for p in paths):
+    if any(not p.lower().endswith(NATIVE) for p in paths):
         from .blender.lift_op import load_image_rgb
         loader = load_image_rgb
     init = read_init(args.init)
@@ -90,4 +88,4 @@ def run_track(args) -> int:
     return 0
 
 
-__all__ = ["add_parsers", "LiftError"]
+__all__ = ["add_parsers"]

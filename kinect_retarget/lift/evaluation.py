@@ -42,23 +42,27 @@ def root_relative(p: np.ndarray, root: int = 0) -> np.ndarray:
     return p - p[:, root:root + 1]
 
 
+def _depth_order(pred, truth, parents, bones, min_depth_m):
+    """(wrong, clear) per (frame, bone): the child's depth offset from its parent has the wrong sign; the
+    true offset is clearly out of the image plane."""
+    dz_p = pred[:, bones, 2] - pred[:, parents[bones], 2]
+    dz_t = truth[:, bones, 2] - truth[:, parents[bones], 2]
+    return np.sign(dz_p) != np.sign(dz_t), np.abs(dz_t) > min_depth_m
+
+
 def sign_error_rate(pred: np.ndarray, truth: np.ndarray, parents: np.ndarray, bones: np.ndarray,
                     min_depth_m: float = 0.05) -> float:
     """Fraction of (frame, bone) samples, among bones clearly out of the image plane, whose depth order
     (child nearer or farther than its parent) is wrong."""
-    dz_p = pred[:, bones, 2] - pred[:, parents[bones], 2]
-    dz_t = truth[:, bones, 2] - truth[:, parents[bones], 2]
-    clear = np.abs(dz_t) > min_depth_m
-    return float(np.mean(np.sign(dz_p[clear]) != np.sign(dz_t[clear]))) if clear.any() else 0.0
+    wrong, clear = _depth_order(pred, truth, parents, bones, min_depth_m)
+    return float(np.mean(wrong[clear])) if clear.any() else 0.0
 
 
 def sign_flip_fraction(pred: np.ndarray, truth: np.ndarray, parents: np.ndarray, bones: np.ndarray,
                        min_depth_m: float = 0.05) -> float:
     """Fraction of frames where some bone's depth offset has the wrong sign (where it is clearly nonzero)."""
-    dz_p = pred[:, bones, 2] - pred[:, parents[bones], 2]
-    dz_t = truth[:, bones, 2] - truth[:, parents[bones], 2]
-    wrong = (np.sign(dz_p) != np.sign(dz_t)) & (np.abs(dz_t) > min_depth_m)
-    return float(np.mean(wrong.any(axis=1)))
+    wrong, clear = _depth_order(pred, truth, parents, bones, min_depth_m)
+    return float(np.mean((wrong & clear).any(axis=1)))
 
 
 def ray_sides(positions: np.ndarray, parents: np.ndarray, camera: Camera | None) -> np.ndarray:

@@ -85,7 +85,7 @@ def group_positions(group: SignGroup, lines: JointLines, anchor: np.ndarray, len
     names = group.joints
     f, t = anchor.shape[:2]
     out = np.zeros((f, t, table.shape[0], len(names), 3))
-    base = np.broadcast_to(anchor[:, :, None, :], out.shape[:3] + (3,))
+    base = anchor[:, :, None, :]   # one anchor for every sign pattern: its children broadcast over them
     for k, bit in enumerate(group.bits):
         for name, mult in bit:
             j = skeleton.index(name)

@@ -2,15 +2,13 @@
 from real mocap projected through the clip's camera, lifted and baked onto a generated rig."""
 from __future__ import annotations
 
-import struct
-import zlib
-
 import numpy as np
 import pytest
 
 from kinect_retarget.core.conventions import kinect_to_blender
 from kinect_retarget.core.skeletons import KINECT_V1
 from kinect_retarget.lift.camera import Camera, view_points
+from kinect_retarget.lift.frames import write_png
 from kinect_retarget.takes import bvh
 
 W, H, FOCAL = 640, 360, 520.0
@@ -22,17 +20,6 @@ TRACK_NAMES = {"HipLeft": "l_hip", "HipRight": "RHip", "KneeLeft": "left knee", 
                "FootLeft": "l_toe", "FootRight": "RBigToe"}
 
 
-def _png(path, w, h):
-    img = np.full((h, w, 3), 120, np.uint8)
-    raw = b"".join(b"\x00" + img[y].tobytes() for y in range(h))
-
-    def chunk(t, d):
-        return struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xFFFFFFFF)
-    with open(path, "wb") as fh:
-        fh.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
-                 + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
-
-
 @pytest.fixture(scope="module")
 def walk_2d(shared_data):
     take = bvh.read(shared_data / "mocap_bvh" / "131_02.bvh")
@@ -42,7 +29,7 @@ def walk_2d(shared_data):
 
 
 def _clip(bpy, tmp_path, uv, names=TRACK_NAMES, first=1):
-    _png(str(tmp_path / "plate.png"), W, H)
+    write_png(str(tmp_path / "plate.png"), np.full((H, W, 3), 120 / 255))
     clip = bpy.data.movieclips.load(str(tmp_path / "plate.png"))
     cam = clip.tracking.camera
     cam.sensor_width = 36.0
@@ -191,7 +178,6 @@ def test_lift_bakes_onto_an_hanim_humanoid(bpy_empty, tmp_path, walk_2d, shared_
 def test_joint_tracker_writes_clip_markers(registered, tmp_path, shared_data):
     """Paper 004's tracker inside Blender: markers on frame 1 of an image-sequence clip of a rendered
     coloured body (real motion), followed through the clip."""
-    from kinect_retarget.lift.frames import write_png
     from kinect_retarget.lift.render import background, render
     bpy = registered
     take = bvh.read(shared_data / "mocap_bvh" / "131_02.bvh")
