@@ -74,11 +74,12 @@ def fetch_wheel(filename: str, cache: Path) -> Path:
     if not m:
         raise BuildError(f"manifest wheel {filename!r} is not a wheel file name")
     cache.mkdir(parents=True, exist_ok=True)
-    cmd = [sys.executable, "-m", "pip", "download", "--quiet", "--no-deps", "--only-binary=:all:",
+    cmd = [sys.executable, "-m", "pip", "download",
+           "--timeout", "30", "--retries", "2",   # an unreachable index fails in minutes, never hangs
+           "--quiet", "--no-deps", "--only-binary=:all:",
            "--python-version", "3.11", "--dest", str(cache), f"{m['dist']}=={m['ver']}"]
     if m["plat"] != "any":
         cmd += [arg for plat in m["plat"].split(".") for arg in ("--platform", plat)]
-    cmd[4:4] = ["--timeout", "30", "--retries", "2"]  # an unreachable index fails in minutes, never hangs
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=DOWNLOAD_TIMEOUT)
     except subprocess.TimeoutExpired:

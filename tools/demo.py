@@ -165,6 +165,8 @@ def make_rigify_rig(path: str) -> None:
     import addon_utils
     import bpy
 
+    from kinect_retarget.blender.headless import save_blend
+
     bpy.ops.wm.read_factory_settings(use_empty=True)
     addon_utils.enable("rigify", default_set=True)
     bpy.ops.object.armature_human_metarig_add()
@@ -176,7 +178,7 @@ def make_rigify_rig(path: str) -> None:
     metarig.hide_viewport = metarig.hide_render = True  # kept for re-generating, out of the pictures
     rig.name = "RigifyRig"
     bpy.context.preferences.filepaths.save_version = 0
-    bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False)
+    save_blend(path)
 
 
 def run_job(job: Job, out: Path, args: argparse.Namespace, rigify_base: str | None) -> Outcome:
@@ -184,7 +186,8 @@ def run_job(job: Job, out: Path, args: argparse.Namespace, rigify_base: str | No
 
     from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
     from kinect_retarget.blender.body_mesh import add_body_mesh
-    from kinect_retarget.blender.render import contact_sheet, render_still, stage
+    from kinect_retarget.blender.headless import save_blend
+    from kinect_retarget.blender.render import contact_sheet, stage, stage_and_render
 
     result = Outcome(job)
     take = read_take(job)
@@ -211,11 +214,13 @@ def run_job(job: Job, out: Path, args: argparse.Namespace, rigify_base: str | No
     scene = bpy.context.scene
     t1 = time.perf_counter()
     frames = still_frames(*baked.frame_range, args.stills)
+    note = f"{name} - {RIGS[job.rig]}"
     with quiet_stdout():
-        stage(scene, [body], frames, f"{name} - {RIGS[job.rig]}", args.resolution)
-        if not args.no_render:
+        if args.no_render:   # the saved file still gets its floor and camera
+            stage(scene, [body], frames, note, args.resolution)
+        else:
             renders = out / "renders"
-            result.stills = [render_still(scene, str(renders / f"{stem}_f{f:04d}.png"), f) for f in frames]
+            result.stills = stage_and_render(scene, [body], frames, str(renders), stem, note, args.resolution)
             if len(result.stills) > 1:
                 result.sheet = contact_sheet(result.stills, str(renders / f"{stem}_sheet.png"))
     result.render_s = time.perf_counter() - t1
@@ -224,7 +229,7 @@ def run_job(job: Job, out: Path, args: argparse.Namespace, rigify_base: str | No
     result.blend = str(out / f"{stem}.blend")
     bpy.context.preferences.filepaths.save_version = 0  # re-running the demo leaves no .blend1 backups
     with quiet_stdout():
-        bpy.ops.wm.save_as_mainfile(filepath=result.blend, check_existing=False)
+        save_blend(result.blend)
     return result
 
 

@@ -63,9 +63,14 @@ def sticks(a, b, radius, mat, name):
     return obj
 
 
+def transformed(points: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """(N, 3) points through the 4x4 transform m."""
+    return points @ m[:3, :3].T + m[:3, 3]
+
+
 def skeleton_picture(mesh: Mesh, rig, m: np.ndarray) -> None:
     """rig: autorig(mesh); m: its upright transform (4x4)."""
-    to_world = lambda p: p @ m[:3, :3].T + m[:3, 3]  # noqa: E731
+    to_world = lambda p: transformed(p, m)  # noqa: E731
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     body = new_mesh_object("Body", to_world(mesh.vertices), mesh.faces, scene.collection)
@@ -93,7 +98,7 @@ def main() -> None:
     skeleton_picture(mesh, rig, m)
     take = load_take(DATA / "kinect_v2" / "recorded_skeleton.json")
     take.metadata.setdefault("name", "recorded_skeleton")
-    out = autorig_to_file(Mesh(mesh.vertices @ m[:3, :3].T + m[:3, 3], mesh.faces, "MakeHuman"),
+    out = autorig_to_file(Mesh(transformed(mesh.vertices, m), mesh.faces, "MakeHuman"),
                           "/tmp/autorig_demo.blend", take=take, render_dir=str(HERE), frames=4)
     for i, path in enumerate(out["renders"]):
         os.replace(path, HERE / f"take_{i + 1}.png")

@@ -132,9 +132,9 @@ def _parent_with_modifier(obj: bpy.types.Object, arm_obj: bpy.types.Object) -> N
     obj.parent = arm_obj
     obj.matrix_parent_inverse = arm_obj.matrix_world.inverted()
     obj.matrix_world = world
-    if not any(m.type == "ARMATURE" for m in obj.modifiers):
-        mod = obj.modifiers.new("Armature", "ARMATURE")
-        mod.object = arm_obj
+    # (rig_mesh_object takes no mesh that already has an Armature modifier)
+    mod = obj.modifiers.new("Armature", "ARMATURE")
+    mod.object = arm_obj
 
 
 def _roll_back(saved, arm_obj) -> None:

@@ -52,18 +52,22 @@ def open_blend(path: str) -> None:
         raise ValueError(f"{path}: not a readable .blend file ({message})") from None
 
 
+def open_target(rig_path: str | None, armature: str | None, preset: str, generate) -> tuple[bpy.types.Object, str]:
+    """(armature, preset) to drive: the named (or only) armature of `rig_path`, or the rig `generate(scene)`
+    builds in an empty file, for which preset "auto" means its own ("kinect")."""
+    if rig_path:
+        open_blend(rig_path)
+        return find_armature(armature), preset
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    return generate(bpy.context.scene), "kinect" if preset == "auto" else preset
+
+
 def bake_to_file(take: Take, out_path: str, *, rig_path: str | None = None, armature: str | None = None,
                  preset: str = "auto", overrides: dict | None = None,
                  settings: RetargetSettings | None = None) -> dict:
     """Bake onto the armature of rig_path (or a generated Kinect rig) and save out_path. Returns a summary."""
     messages: list[str] = []
-    if rig_path:
-        open_blend(rig_path)
-        obj = find_armature(armature)
-    else:
-        bpy.ops.wm.read_factory_settings(use_empty=True)
-        obj = new_generated_rig(bpy.context.scene, take)
-        preset = "kinect" if preset == "auto" else preset
+    obj, preset = open_target(rig_path, armature, preset, lambda scene: new_generated_rig(scene, take))
     bpy.context.view_layer.objects.active = obj
     def report(level, msg):
         messages.append(msg)

@@ -40,7 +40,7 @@ _last_status: dict = {"state": "idle", "message": "", "error": None, "stats": No
 
 class LiveController:
     def __init__(self, scene, obj, session: LiveSession, preset: str, overrides, settings: RetargetSettings,
-                 source_label: str):
+                 source_label: str, saved: dict):
         self.scene_name, self.obj_name = scene.name, obj.name
         self.session = session
         self.preset, self.overrides, self.settings = preset, overrides, settings
@@ -50,19 +50,15 @@ class LiveController:
         self.recording: dict | None = None
         self.baked_action: str | None = None
         self.started_at = time.perf_counter()
-        self._saved = _save_state(obj)
-        try:
-            self._rigify_fk(obj)
-            pipeline = session.pipeline
-            corrector = ConstrainedParentCorrection(pipeline.rig, pipeline.bone_names, constrained_bones(obj))
-            self.corrector = corrector if corrector.active else None
-            self.update_after_apply = bool(bpy.app.background)
-            self.exact = bool(scene.kinect_retarget.exact_constrained)
-            if self.corrector is not None:
-                self._read = [(b, pipeline.rig.bone_names[b]) for b in self.corrector.read]
-        except Exception:
-            _restore_state(obj, self._saved, keep_animation=False)  # the rig must not stay half-switched
-            raise
+        self._saved = saved   # the rig's pose, action and switches before live: put back by finish()
+        self._rigify_fk(obj)
+        pipeline = session.pipeline
+        corrector = ConstrainedParentCorrection(pipeline.rig, pipeline.bone_names, constrained_bones(obj))
+        self.corrector = corrector if corrector.active else None
+        self.update_after_apply = bool(bpy.app.background)
+        self.exact = bool(scene.kinect_retarget.exact_constrained)
+        if self.corrector is not None:
+            self._read = [(b, pipeline.rig.bone_names[b]) for b in self.corrector.read]
 
     # -- helpers -------------------------------------------------------------------------------------------
     def obj(self):
@@ -91,7 +87,7 @@ class LiveController:
         if self.corrector is not None:
             desired = pose.desired
             pose.quats = self.corrector.correct(pose.quats, self._evaluated(obj), desired)
-            if self.exact and desired is not None:  # the bake's own correction, from this close start
+            if self.exact:  # the bake's own correction, from this close start
                 pose.quats = correct_for_evaluation(obj, pose.bone_names, pose.quats[None], pose.root_bone,
                                                     pose.root_location[None], desired[None])[0]
         apply_frame_pose(obj, pose)
@@ -357,12 +353,13 @@ def start_live(context, source=None, use_timer: bool = True) -> LiveController:
             pass  # a stale or foreign calibration: live still works, uncalibrated
     timeout = prefs.lost_tracking_timeout if prefs is not None else 2.0
     session = LiveSession(source, pipeline, lambda pose: None, lost_tracking_timeout=timeout)
-    controller = LiveController(scene, obj, session, used, overrides, settings, label)
-    session.apply = controller.apply
+    saved = _save_state(obj)
     try:
+        controller = LiveController(scene, obj, session, used, overrides, settings, label, saved)
+        session.apply = controller.apply
         session.start()
-    except Exception:  # any failure: the rig gets its pose and action back before the error goes up
-        _restore_state(obj, controller._saved, keep_animation=False)
+    except Exception:  # any failure: the rig gets its pose, action and switches back before the error goes up
+        _restore_state(obj, saved, keep_animation=False)
         raise
     _controller = controller
     _last_status.update(state="running", message=controller.message, error=None, stats=None)
@@ -407,24 +404,17 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
     """The `live` command: open the rig (or build the generated one with `rig_lengths`), run the pump loop
     for `seconds` (or until the source ends), bake the recording, save `out`. Returns the statistics."""
     from .. import register, unregister
-    from .headless import blender_message, find_armature, open_blend, save_blend
+    from .headless import blender_message, open_target, save_blend
     from .kinect_rig import build_kinect_rig
     from .mapping_ui import fill_table
 
-    if rig_path:
-        open_blend(rig_path)
-        register()
-        try:
-            obj = find_armature(armature)
-        except ValueError:
-            unregister()
-            raise
-    else:
-        bpy.ops.wm.read_factory_settings(use_empty=True)
-        register()
-        obj = build_kinect_rig(bpy.context.scene, source.skeleton, rig_lengths, "KinectRig")
-        preset = "kinect" if preset == "auto" else preset
-        set_scene_rate(bpy.context.scene, source.rate)  # a new scene runs at the source's rate, as `bake` sets it
+    def generate(scene):
+        obj = build_kinect_rig(scene, source.skeleton, rig_lengths, "KinectRig")
+        set_scene_rate(scene, source.rate)  # a new scene runs at the source's rate, as `bake` sets it
+        return obj
+
+    obj, preset = open_target(rig_path, armature, preset, generate)
+    register()   # once the rig is there: neither opening nor building it needs the add-on
     try:
         bpy.context.view_layer.objects.active = obj
         s = bpy.context.scene.kinect_retarget
