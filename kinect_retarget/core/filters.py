@@ -123,17 +123,14 @@ class OneEuroFilter:
         return self._x.copy()
 
     def _advance(self, x: np.ndarray, valid: np.ndarray, dt: float, all_valid: bool) -> None:
-        """One filter step, in place on preallocated buffers (this loop runs once per frame)."""
-        if getattr(self, "_buf", None) is None or self._buf[0].shape != x.shape:
-            self._buf = [np.empty_like(x) for _ in range(3)]
-        diff, speed, gain = self._buf
-        np.subtract(x, self._x, out=diff)
-        np.multiply(diff, 1.0 / dt, out=speed)
+        """One filter step."""
+        diff = x - self._x
+        speed = diff * (1.0 / dt)
         dx_hat = self._dx + self._alpha(self.d_cutoff, dt) * (speed - self._dx)
-        np.abs(dx_hat, out=gain)                       # cutoff = min_cutoff + beta·|speed|, then
+        gain = np.abs(dx_hat)                          # cutoff = min_cutoff + beta·|speed|, then
         gain *= self.beta * 2 * math.pi * dt           # gain = 2π·dt·cutoff / (1 + 2π·dt·cutoff)
         gain += self.min_cutoff * 2 * math.pi * dt
-        np.divide(gain, gain + 1.0, out=gain)
+        gain = gain / (gain + 1.0)
         diff *= gain
         if all_valid:  # the common case skips the bookkeeping below; same numbers
             self._x = self._x + diff

@@ -59,7 +59,7 @@ class FramePose:
     root_bone: str | None
     root_location: np.ndarray  # (3,)
     time: float
-    desired: np.ndarray | None = None  # (M, 4) armature-space rotations, for rigs with constrained parents
+    desired: np.ndarray        # (M, 4) armature-space rotations, for rigs with constrained parents
 
 
 class RetargetPipeline:

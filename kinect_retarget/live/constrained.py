@@ -25,32 +25,19 @@ class ConstrainedParentCorrection:
         rot = rig.rest[:, :3, :3]
         self.rel = {b: (rot[b] if rig.parents[b] < 0 else rot[rig.parents[b]].T @ rot[b]) for b in self.order}
         # bones whose evaluated matrix is read: constrained ones that are not mapped, and their parents
-        self.constrained_unmapped = sorted(b for b in self.constrained if b not in self.slot)
-        self.read = sorted(set(self.constrained_unmapped) |
+        self.constrained_unmapped = {b for b in self.constrained if b not in self.slot}
+        self.read = sorted(self.constrained_unmapped |
                            {int(rig.parents[b]) for b in self.constrained_unmapped if rig.parents[b] >= 0})
 
     @property
     def active(self) -> bool:
         return bool(self.constrained_unmapped)
 
-    def desired_from_quats(self, quats: np.ndarray) -> np.ndarray:
-        """Armature-space rotations the solver meant, from its quats, under plain parenting (M, 3, 3)."""
-        posed = {}
-        basis = to_matrix(quats)
-        rot = self.rig.rest[:, :3, :3]
-        for b in self.order:
-            p = int(self.rig.parents[b])
-            frame = rot[b] if p < 0 or not self.rig.inherit_rotation[b] else posed[p] @ self.rel[b]
-            posed[b] = frame @ basis[self.slot[b]] if b in self.slot else frame
-        return np.stack([posed[b] for b in self.mapped])
-
-    def correct(self, quats: np.ndarray, evaluated: dict, desired: np.ndarray | None = None) -> np.ndarray:
+    def correct(self, quats: np.ndarray, evaluated: dict, desired: np.ndarray) -> np.ndarray:
         """quats (M, 4) solved for plain parenting -> quats that give the desired rotations under the actual
         parents. evaluated: bone index -> (3, 3) armature-space rotation from the last evaluation; desired:
-        (M, 3, 3) matrices or (M, 4) quaternions, from the solver (else derived from quats)."""
-        if desired is None:
-            desired = self.desired_from_quats(quats)
-        elif np.shape(desired)[-1] == 4:  # the engine may hand desired rotations as quaternions
+        (M, 3, 3) matrices or (M, 4) quaternions, from the solver (FramePose.desired)."""
+        if np.shape(desired)[-1] == 4:  # the engine hands desired rotations as quaternions
             desired = to_matrix(desired)
         out = np.array(quats, dtype=np.float64)
         actual = {}

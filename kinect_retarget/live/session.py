@@ -14,7 +14,6 @@ from typing import Callable
 import numpy as np
 
 from ..core.skeletons import NOT_TRACKED
-from .batching import process_batch
 from .calibration import CalibrationCapture
 from .queueing import FrameQueue
 from .recording import Recorder
@@ -135,8 +134,9 @@ class LiveSession:
         newest = None
         if last_tracked is not None:
             try:
-                pose = process_batch(self.pipeline, np.stack([f.positions for f in frames]),
-                                     np.stack([f.states for f in frames]), times)
+                # every drained frame goes through the filter (live equals the bake); only the newest is solved
+                pose = self.pipeline.process_frames(np.stack([f.positions for f in frames]),
+                                                    np.stack([f.states for f in frames]), times)
             except Exception as exc:  # the engine names the problem; live must stop, not crash the host
                 self.stop(f"retarget failed near frame {self.stats.received}: {exc}")
                 return False

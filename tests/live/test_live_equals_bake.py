@@ -48,8 +48,6 @@ def test_live_pose_equals_baked_pose(wave_take, tmp_path, filter_name):
 
 def test_batch_equals_frame_by_frame(wave_take):
     """The pump filters every drained frame but solves only the newest: same pose as process_frame each."""
-    from kinect_retarget.live.batching import process_batch
-
     sk = wave_take.skeleton
     rig = generated_rig(sk, median_segment_lengths(wave_take))
     one = RetargetPipeline(sk, rig, generated_mapping(sk), RetargetSettings())
@@ -61,7 +59,7 @@ def test_batch_equals_frame_by_frame(wave_take):
         last = None
         for i in range(a, b):
             last = one.process_frame(wave_take.positions[i], states[i], float(wave_take.times[i])) or last
-        got = process_batch(many, wave_take.positions[a:b], states[a:b], wave_take.times[a:b])
+        got = many.process_frames(wave_take.positions[a:b], states[a:b], wave_take.times[a:b])
         assert np.degrees(angle_between(got.quats, last.quats)).max() < 1e-9
         np.testing.assert_allclose(got.root_location, last.root_location, atol=1e-12)
         assert got.time == last.time
