@@ -46,7 +46,7 @@ def vertex_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 
 def ring_centroid(vertices: np.ndarray, field: np.ndarray, g: float, width: float,
-                  mask: np.ndarray | None = None, area: np.ndarray | None = None) -> np.ndarray:
+                  mask: np.ndarray | None, area: np.ndarray) -> np.ndarray:
     """Area-weighted centroid of the vertices whose geodesic value is within `width` of g (the band is
     widened until it holds vertices)."""
     for w in (width, 2 * width, 4 * width, 8 * width):
@@ -54,8 +54,7 @@ def ring_centroid(vertices: np.ndarray, field: np.ndarray, g: float, width: floa
         if mask is not None:
             band &= mask
         if band.any():
-            wt = None if area is None else area[band] + 1e-30
-            return np.average(vertices[band], axis=0, weights=wt)
+            return np.average(vertices[band], axis=0, weights=area[band] + 1e-30)
     near = np.argmin(np.abs(field - g) + (0 if mask is None else np.where(mask, 0, np.inf)))
     return vertices[near].copy()
 

@@ -3,18 +3,13 @@ import numpy as np
 import pytest
 
 from kinect_retarget.autorig import MeshError, autorig
-from kinect_retarget.autorig.evaluation import (joint_errors, load_makehuman, pose_body, reference_joints,
+from kinect_retarget.autorig.evaluation import (joint_errors, pose_body, reference_joints,
                                                 rotations_from_cmu, rotations_from_makehuman_bvh, symmetry_error)
 from kinect_retarget.autorig.features import LABELS
 from kinect_retarget.autorig.inside import inside_mesh
 from kinect_retarget.autorig.mesh import Mesh
 from kinect_retarget.core.skeletons import KINECT_V1
 from kinect_retarget.takes.bvh import read_bvh_skeleton
-
-
-@pytest.fixture(scope="module")
-def mh(shared_data):
-    return load_makehuman(shared_data / "meshes" / "makehuman")
 
 
 @pytest.fixture(scope="module")

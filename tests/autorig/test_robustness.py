@@ -1,20 +1,14 @@
 """Imperfect meshes: holes, non-manifold fins, uneven triangles with T-junctions, the T-pose."""
 import numpy as np
-import pytest
 
 from kinect_retarget.autorig import autorig
-from kinect_retarget.autorig.evaluation import (joint_errors, load_makehuman, pose_body, reference_joints,
+from kinect_retarget.autorig.evaluation import (joint_errors, pose_body, reference_joints,
                                                 rotations_from_makehuman_bvh)
 from kinect_retarget.autorig.mesh import Mesh, subdivide
 from kinect_retarget.core.skeletons import KINECT_V1
 from kinect_retarget.takes.bvh import read_bvh_skeleton
 
 LIMIT = 3.0  # % of height: the goal holds for meshes damaged on purpose too
-
-
-@pytest.fixture(scope="module")
-def mh(shared_data):
-    return load_makehuman(shared_data / "meshes" / "makehuman")
 
 
 def _check(mh, mesh, ref=None):

@@ -1,0 +1,9 @@
+"""The MakeHuman base mesh and its reference skeleton, loaded once for the auto-rig tests (none changes it)."""
+import pytest
+
+from kinect_retarget.autorig.evaluation import load_makehuman
+
+
+@pytest.fixture(scope="session")
+def mh(shared_data):
+    return load_makehuman(shared_data / "meshes" / "makehuman")
