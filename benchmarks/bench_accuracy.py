@@ -14,6 +14,7 @@ import numpy as np
 from _common import SAMPLE_TAKES
 
 from kinect_retarget.core.conventions import kinect_to_blender
+from kinect_retarget.core.joint_frames import resolver
 from kinect_retarget.core.pipeline import RetargetSettings
 from kinect_retarget.takes import load_take
 
@@ -85,11 +86,10 @@ def rigify(bpy, rig_path, path, frames=90):
             k = names.index(f"DEF-{bone}.{s}")
             errs.append(angle_deg(tails[:, k] - heads[:, k], src[:, sk.index(b + side)] - src[:, sk.index(a + side)]))
     spine = []
+    get = resolver(sk.joints, src)   # v1 names, or v2's SpineBase / SpineMid / SpineShoulder
     for bone, a, b in (("DEF-spine.001", "HipCenter", "Spine"), ("DEF-spine.003", "Spine", "ShoulderCenter")):
         k = names.index(bone)
-        ia, ib = (sk.index(j) if j in sk.joints else sk.index({"HipCenter": "SpineBase", "Spine": "SpineMid",
-                  "ShoulderCenter": "SpineShoulder"}[j]) for j in (a, b))
-        spine.append(angle_deg(tails[:, k] - heads[:, k], src[:, ib] - src[:, ia]))
+        spine.append(angle_deg(tails[:, k] - heads[:, k], get(b) - get(a)))
     return np.mean(errs), np.max(errs), np.mean(spine), np.max(spine)
 
 

@@ -92,11 +92,11 @@ def main() -> None:
         groups.setdefault(" ".join(label.split()[:2]), []).append(e)
         print(row(label, e))
     print(f"\n{'group':28s} meshes  mean   max  within {TOLERANCE:.0f} %")
-    for title, clips in [(None, list(groups))] + [("development clips", [f"CMU {c}" for c in DEVELOPMENT]),
-                                                   ("held-out clips", [f"CMU {c}" for c in HELD_OUT])]:
-        for key in ([title] if title else clips):
-            g = np.array(sum((groups[c] for c in (clips if title else [key])), []))
-            print(f"{key:28s} {len(g):6d} {g.mean():5.2f} {g.max():5.2f}  {(g <= TOLERANCE).mean():7.1%}")
+    rows = list(groups.items()) + [(title, [e for c in clips for e in groups[f"CMU {c}"]])
+                                   for title, clips in (("development clips", DEVELOPMENT), ("held-out clips", HELD_OUT))]
+    for key, errors in rows:
+        g = np.array(errors)
+        print(f"{key:28s} {len(g):6d} {g.mean():5.2f} {g.max():5.2f}  {(g <= TOLERANCE).mean():7.1%}")
     stack = np.array(all_err)
     print(f"\nover {len(stack)} meshes: mean {stack.mean():.2f} %, median joint max {np.median(stack.max(1)):.2f} %, "
           f"worst {stack.max():.2f} %; joints within {TOLERANCE:.0f} %: {(stack <= TOLERANCE).mean():.1%}; "

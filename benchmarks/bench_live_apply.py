@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 
-from _common import SAMPLE_TAKES
+from _live_bench import live_scene
 
 
 def measure(obj, take, preset: str, frames: int) -> dict:
@@ -23,7 +23,6 @@ def measure(obj, take, preset: str, frames: int) -> dict:
     import bpy
 
     from kinect_retarget.blender import live
-    from kinect_retarget.live.batching import process_batch
     from kinect_retarget.sources.base import FrameSource
 
     class Idle(FrameSource):
@@ -43,7 +42,7 @@ def measure(obj, take, preset: str, frames: int) -> dict:
     solve, apply, update = [], [], []
     for i in range(n):
         t0 = time.perf_counter()
-        pose = process_batch(pipeline, take.positions[i:i + 1], take.states[i:i + 1], take.times[i:i + 1])
+        pose = pipeline.process_frames(take.positions[i:i + 1], take.states[i:i + 1], take.times[i:i + 1])
         t1 = time.perf_counter()
         if pose is None:
             continue
@@ -72,14 +71,8 @@ def main() -> None:
     import bpy
 
     import kinect_retarget
-    from kinect_retarget.blender.kinect_rig import build_kinect_rig
-    from kinect_retarget.core.kinect_rig_layout import median_segment_lengths
-    from kinect_retarget.takes import load_take
 
-    take = load_take(SAMPLE_TAKES / "kinect_v2_ges03_drawlines.krtake")
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    kinect_retarget.register()
-    obj = build_kinect_rig(bpy.context.scene, take.skeleton, median_segment_lengths(take), "KinectRig")
+    take, obj = live_scene(speed=1.0)   # the sample take, a generated rig, the add-on registered
     results = {"generated_rig": measure(obj, take, "kinect", args.frames)}
     if not args.no_rigify:
         bpy.ops.wm.read_factory_settings(use_empty=True)
