@@ -1,4 +1,5 @@
-"""Shared fixtures. Real data lives in ../shared/data next to the repository (CI clones it that way)."""
+"""Shared fixtures. Real data: the repository's tests/data (see tests/data/CREDITS.md), served by `shared_data`
+at the same sub-paths as in the workshop's shared/data folder."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -7,15 +8,14 @@ import numpy as np
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
-SHARED_DATA = REPO.parent / "shared" / "data"
 SAMPLE_TAKES = REPO / "sample_takes"
 
 
 @pytest.fixture(scope="session")
-def shared_data() -> Path:
-    if not SHARED_DATA.is_dir():
-        pytest.fail(f"shared data not found at {SHARED_DATA}: clone the repository beside shared/")
-    return SHARED_DATA
+def shared_data(tmp_path_factory) -> Path:
+    """tests/data, gzipped files decompressed, laid out like shared/data (tests/repo_data.py)."""
+    from tests.repo_data import materialize
+    return materialize(tmp_path_factory.mktemp("data"))
 
 
 @pytest.fixture

@@ -4,7 +4,7 @@
 
 1. skeleton.png: MakeHuman's base mesh (CC0), see-through, with the extracted Kinect joints and bones (red)
    and the paper's skeleton points (blue); 2. take_f*.png: the auto-rigged mesh driven by a real Kinect v2
-   recording (Kinectron, MIT).
+   recording (Kinectron, MIT; sample_takes/kinect_v2_kinectron_recorded_skeleton.krtake).
 """
 from __future__ import annotations
 
@@ -17,10 +17,11 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 HERE = REPO / "docs" / "autorig"
 sys.path.insert(0, str(REPO))
-DATA = REPO.parent / "shared" / "data"
+SAMPLE_TAKES = REPO / "sample_takes"
 
 import bpy  # noqa: E402
 
+from kinect_retarget.assets import MAKEHUMAN_DIR  # noqa: E402
 from kinect_retarget.autorig import Mesh, autorig, load_mesh  # noqa: E402
 from kinect_retarget.autorig.orient import upright_transform  # noqa: E402
 from kinect_retarget.blender.autorig_op import autorig_to_file, new_mesh_object  # noqa: E402
@@ -91,12 +92,12 @@ def skeleton_picture(mesh: Mesh, rig, m: np.ndarray) -> None:
 
 
 def main() -> None:
-    mesh = load_mesh(DATA / "meshes" / "makehuman" / "base.obj", group="body")
+    mesh = load_mesh(MAKEHUMAN_DIR / "base.obj", group="body")
     rig = autorig(mesh)
     m = upright_transform(mesh.vertices, np.asarray(rig.features.up), np.asarray(rig.features.front),
                           rig.height, rig.joints[0])
     skeleton_picture(mesh, rig, m)
-    take = load_take(DATA / "kinect_v2" / "recorded_skeleton.json")
+    take = load_take(SAMPLE_TAKES / "kinect_v2_kinectron_recorded_skeleton.krtake")  # the Kinectron recording
     take.metadata.setdefault("name", "recorded_skeleton")
     out = autorig_to_file(Mesh(transformed(mesh.vertices, m), mesh.faces, "MakeHuman"),
                           "/tmp/autorig_demo.blend", take=take, render_dir=str(HERE), frames=4)

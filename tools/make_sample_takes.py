@@ -1,6 +1,8 @@
 """Build sample_takes/: real recordings converted to the project's .krtake format (deterministic).
 
-    .venv/bin/python tools/make_sample_takes.py [--data ../shared/data] [--out sample_takes]
+    .venv/bin/python tools/make_sample_takes.py [--data DIR] [--out sample_takes]
+
+DIR defaults to the repository's tests/data (decompressed into a temporary folder by tests/repo_data.py).
 
 * Kinect v2 (25 joints): Microsoft LabanotationSuite gestures Ges01-06 and joints.csv, the Kinectron recording.
 * Kinect v1 (20 joints): CMU optical mocap (BVH) sampled at the Kinect v1 joints, seen by a virtual sensor
@@ -15,6 +17,7 @@ from __future__ import annotations
 import argparse
 import shutil
 import sys
+import tempfile
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
@@ -22,6 +25,7 @@ sys.path.insert(0, str(REPO))
 
 from kinect_retarget.core.take import Take  # noqa: E402
 from kinect_retarget.takes import bvh, kinect_v2_csv, kinectron_json, krtake  # noqa: E402
+from tests.repo_data import materialize  # noqa: E402
 
 LABAN = {"source": "microsoft/LabanotationSuite @ c135c9016783444b112083aad3dd63e851b9f8fe",
          "license": "MIT", "credit": "LabanotationSuite, Copyright (c) Microsoft Corporation"}
@@ -113,11 +117,13 @@ def build(data: Path, out: Path) -> dict[str, Path]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--data", type=Path, default=REPO.parent / "shared" / "data")
+    ap.add_argument("--data", type=Path, help="a folder laid out like shared/data (default: tests/data)")
     ap.add_argument("--out", type=Path, default=REPO / "sample_takes")
     args = ap.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        written = build(args.data or materialize(Path(tmp) / "data"), args.out)
     total = 0
-    for name, path in build(args.data, args.out).items():
+    for name, path in written.items():
         take = krtake.read(path)
         size = path.stat().st_size
         total += size

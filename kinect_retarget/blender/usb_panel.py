@@ -64,14 +64,14 @@ def _device_summary(info) -> dict:
 
 # -- the simulated Kinect ---------------------------------------------------------------------------------------
 def simulated_images() -> tuple[list[np.ndarray], str]:
-    """Raw depth frames for the emulated Kinect: rendered real motion when the shared data is there (cached
-    after the first render), else the driver's synthetic figure."""
+    """Raw depth frames for the emulated Kinect: real motion rendered from the package's assets (cached after
+    the first render), else (assets missing) the driver's synthetic figure."""
     try:
         from ..depth.producer import simulated_frames
         return simulated_frames(SIM_FRAMES), "rendered CMU mocap 131_03"
     except (ImportError, FileNotFoundError):
         from ..device.depth_images import synthetic_depth_frames
-        return synthetic_depth_frames(), "synthetic figure (the rendered mocap needs the shared data folder)"
+        return synthetic_depth_frames(), "synthetic figure (the package's mocap assets are missing)"
 
 
 def _prepare_simulated() -> None:

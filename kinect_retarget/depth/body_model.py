@@ -67,7 +67,7 @@ def _driver_of_bone(bones: dict) -> dict[str, str]:
 
 @lru_cache(maxsize=2)
 def load_body(mesh_dir: str) -> BodyModel:
-    """Load base.obj, default.mhskel and default_weights.mhw from `mesh_dir` (shared/data/meshes/makehuman)."""
+    """Load base.obj, default.mhskel and default_weights.mhw from `mesh_dir` (kinect_retarget/assets/makehuman)."""
     verts_all, faces = _read_obj_body(os.path.join(mesh_dir, "base.obj"))
     with open(os.path.join(mesh_dir, "default.mhskel"), encoding="utf-8") as fh:
         skel = json.load(fh)

@@ -65,20 +65,22 @@ class DepthSkeletonProducer:
             self.stream.stop()
 
 
-def simulated_frames(frames: int = 90, clip: str = "131_03", shared_data: str | None = None) -> list[np.ndarray]:
-    """Raw 11-bit frames of a rendered real motion for the emulated Kinect, cached on disk (rendering
-    takes about half a second per frame the first time)."""
-    from .synthetic import Scenario, default_mesh_dir, render_sequence
-    data = Path(shared_data) if shared_data else Path(__file__).resolve().parents[3] / "shared" / "data"
+def simulated_frames(frames: int = 90, clip: str = "131_03") -> list[np.ndarray]:
+    """Raw 11-bit frames of a real motion (a CMU clip the package ships) rendered on the MakeHuman body, for the
+    emulated Kinect; cached on disk (rendering takes about half a second per frame the first time)."""
+    from ..assets import MAKEHUMAN_DIR, motion_clip
+    from .synthetic import Scenario, render_sequence
+    bvh = motion_clip(clip)
+    if not bvh.is_file():
+        raise FileNotFoundError(f"{bvh}: the simulated Kinect's motion is missing from the package")
     cache = Path(os.environ.get("KR_DEPTH_CACHE", Path(tempfile.gettempdir()) / "kinect_retarget_depth_cache"))
     cache.mkdir(parents=True, exist_ok=True)
     path = cache / f"simulate_{clip}_{frames}.npy"
     if path.exists():
         return list(np.load(path))
-    bvh = data / "mocap_bvh" / f"{clip}.bvh"
-    if not bvh.exists():
-        raise FileNotFoundError(f"{bvh}: the simulated Kinect renders CMU mocap from the shared data folder")
-    seq = render_sequence(str(bvh), default_mesh_dir(str(data)), Scenario(seed=11), frames=frames)
+    seq = render_sequence(str(bvh), str(MAKEHUMAN_DIR), Scenario(seed=11), frames=frames)
+    if len(seq.raw) < frames:
+        raise ValueError(f"{bvh} holds {len(seq.raw)} frames at 30 fps, {frames} asked")
     np.save(path, seq.raw)
     return list(seq.raw)
 

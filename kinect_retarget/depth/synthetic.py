@@ -6,7 +6,6 @@ floor is turned to face the sensor and compressed to stay 1.5-3.5 m away (a Kine
 """
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -51,11 +50,6 @@ class SyntheticSequence:
         np.savez_compressed(path, raw=self.raw, mm=self.mm, timestamp=self.timestamp, times=self.times,
                             gravity=self.gravity, gt_joints=self.joints, gt_present=self.present,
                             focal=self.camera.f, cx=self.camera.cx, cy=self.camera.cy)
-
-
-def default_mesh_dir(shared_data: str) -> str:
-    """The MakeHuman base mesh folder inside the shared data folder."""
-    return os.path.join(shared_data, "meshes", "makehuman")
 
 
 def _placement(cmu: dict, sc: Scenario, nf: int, fps: float):

@@ -175,11 +175,11 @@ def test_depth_stream_preview_updates_the_image(registered, fakenect_frames):
 
 
 @pytest.fixture
-def rendered_frames(tmp_path_factory, shared_data, monkeypatch):
+def rendered_frames(tmp_path_factory, monkeypatch):
     """Six frames of CMU mocap rendered as Kinect depth (the simulated Kinect's own content), cached."""
     from kinect_retarget.depth.producer import simulated_frames
     monkeypatch.setenv("KR_DEPTH_CACHE", str(tmp_path_factory.getbasetemp() / "depth_cache"))
-    return simulated_frames(6, shared_data=str(shared_data))
+    return simulated_frames(6)   # from the package's own assets
 
 
 def test_live_on_the_simulated_kinect_previews_person_and_skeleton(registered, monkeypatch, rendered_frames):

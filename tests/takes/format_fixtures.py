@@ -102,5 +102,9 @@ def make_all(shared_data: Path, out: Path = FIXTURES) -> dict[str, Path]:
 
 
 if __name__ == "__main__":
-    for name, p in make_all(Path(__file__).resolve().parents[3] / "shared" / "data").items():
-        print(name, p, p.stat().st_size)
+    import tempfile
+
+    from tests.repo_data import materialize
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, p in make_all(materialize(Path(tmp) / "data")).items():
+            print(name, p, p.stat().st_size)
