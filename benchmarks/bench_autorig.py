@@ -18,7 +18,6 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
-DATA = REPO.parent / "shared" / "data"
 
 from kinect_retarget.autorig import autorig, load_mesh  # noqa: E402
 from kinect_retarget.autorig.evaluation import (joint_errors, load_makehuman, pose_body,  # noqa: E402
@@ -31,6 +30,10 @@ from kinect_retarget.autorig.levels import reeb_baseline  # noqa: E402
 from kinect_retarget.autorig.mesh import Mesh, subdivide  # noqa: E402
 from kinect_retarget.core.skeletons import KINECT_V1  # noqa: E402
 from kinect_retarget.takes.bvh import read_bvh_skeleton  # noqa: E402
+
+from _common import shared_data_or_skip  # noqa: E402
+
+DATA = shared_data_or_skip(__file__)
 
 TOLERANCE = 3.0  # % of body height
 DEVELOPMENT = ("131_01", "131_02")  # clips the joint placement was developed on

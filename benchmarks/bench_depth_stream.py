@@ -27,7 +27,9 @@ from kinect_retarget.device.protocol import DEPTH_PACKETS_PER_FRAME  # noqa: E40
 from kinect_retarget.device.reassembly import FrameAssembler  # noqa: E402
 from kinect_retarget.device.stream import DepthStream  # noqa: E402
 
-FAKENECT = REPO.parent / "shared" / "data" / "depth_real" / "fakenect_openiss" / "fakenect-record"
+from _common import shared_data_or_skip  # noqa: E402
+
+FAKENECT = shared_data_or_skip(__file__) / "depth_real" / "fakenect_openiss" / "fakenect-record"
 
 
 def _ms(values):

@@ -21,12 +21,15 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
-DATA = REPO.parent / "shared" / "data"
 
 from kinect_retarget.core.skeletons import KINECT_V1, NOT_TRACKED  # noqa: E402
 from kinect_retarget.depth.evaluation import facing_angle, score  # noqa: E402
 from kinect_retarget.depth.synthetic import Scenario, render_sequence  # noqa: E402
 from kinect_retarget.depth.tracker import SkeletonTracker  # noqa: E402
+
+from _common import shared_data_or_skip  # noqa: E402
+
+DATA = shared_data_or_skip(__file__)
 
 # name: (clip, first BVH frame at 120 fps, frames at 30 fps, scenario)
 MOTIONS = {

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import time
 
-from _common import SHARED_DATA
+from _common import shared_data_or_skip
 
 from kinect_retarget.core.filters import jitter, lag_frames, make_filter
 from kinect_retarget.takes import load_take
 
+SHARED_DATA = shared_data_or_skip(__file__)
 TAKES = sorted((SHARED_DATA / "kinect_v2").glob("*.csv")) + [SHARED_DATA / "kinect_v2" / "recorded_skeleton.json"]
 
 

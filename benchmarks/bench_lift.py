@@ -26,7 +26,10 @@ from kinect_retarget.lift.lifter import LiftSettings, lift  # noqa: E402
 from kinect_retarget.lift.tracks2d import Tracks2D  # noqa: E402
 from kinect_retarget.takes import bvh, kinectron_json  # noqa: E402
 
-DATA = REPO.parent / "shared" / "data"
+from _common import shared_data_or_skip  # noqa: E402
+
+DATA = shared_data_or_skip(__file__)
+
 IMAGE = (1280, 720)
 FOCAL = 1000.0
 VIEWS = ((0, 5), (45, 5), (90, 5), (135, 10), (180, 5), (-60, 20))  # azimuth, elevation (deg)

@@ -17,7 +17,7 @@ import _common  # noqa: F401 (puts the repository on sys.path)
 from kinect_retarget.takes import bvh, kinect_v2_csv, kinectron_json, krtake, msrc12, ntu_skeleton, utkinect
 from tests.takes import format_fixtures as fx
 
-DATA = _common.SHARED_DATA
+DATA = _common.shared_data_or_skip(__file__)
 N = 10_000
 
 

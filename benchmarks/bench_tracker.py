@@ -21,7 +21,10 @@ from kinect_retarget.lift.render import background, render  # noqa: E402
 from kinect_retarget.lift.tracker import JointTracker, TrackerSettings  # noqa: E402
 from kinect_retarget.takes import bvh  # noqa: E402
 
-DATA = REPO.parent / "shared" / "data"
+from _common import shared_data_or_skip  # noqa: E402
+
+DATA = shared_data_or_skip(__file__)
+
 TRACKED = ("HipCenter", "ShoulderCenter", "Head", "ShoulderLeft", "ElbowLeft", "WristLeft", "ShoulderRight",
            "ElbowRight", "WristRight", "HipLeft", "KneeLeft", "AnkleLeft", "HipRight", "KneeRight", "AnkleRight")
 
