@@ -35,11 +35,22 @@ def add_parsers(sub) -> None:
 
 def take_summary(path: str) -> dict:
     take = load_take(path)
+    meta = take.metadata
     return {"file": os.path.basename(path), "format": take.source_format, "skeleton": take.skeleton.name,
             "joints": len(take.skeleton), "frames": take.frame_count, "duration_s": round(take.duration, 3),
-            "rate_fps": take.rate, "tracked_fraction": round(take.tracked_fraction, 4),
-            "frames_with_body": int(np.count_nonzero(take.any_tracked)),
-            **({"warnings": take.metadata["warnings"]} if take.metadata.get("warnings") else {})}
+            "rate_fps": take.rate, "time_unit": meta.get("time_unit", "s"),
+            "tracked_fraction": round(take.tracked_fraction, 4),
+            "frames_with_body": int(np.count_nonzero(take.any_tracked)), **dropped_summary(meta),
+            **({"warnings": meta["warnings"]} if meta.get("warnings") else {})}
+
+
+def dropped_summary(meta: dict) -> dict:
+    """How many joint samples the reader dropped as unusable (NaN, inf, absurd) and where the first was."""
+    if not meta.get("dropped_joint_samples"):
+        return {}
+    first = next((f"{k[len('first_dropped_'):]} {v}" for k, v in meta.items() if k.startswith("first_dropped_")),
+                 "")
+    return {"dropped_joint_samples": meta["dropped_joint_samples"], "first_dropped": first}
 
 
 def run_info(args) -> int:

@@ -67,6 +67,8 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
     pipeline, used = make_pipeline(obj, take.skeleton, preset, overrides, settings)
     for problem in mapping_problems(pipeline.rig.bone_names, overrides):
         report({"WARNING"}, problem)
+    for warning in take.metadata.get("warnings", ()):  # what the reader dropped (bad samples, a cut-off line)
+        report({"WARNING"}, warning)
     motion = pipeline.process_take(take)
     if progress:
         progress(0.3)

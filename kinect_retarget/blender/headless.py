@@ -77,4 +77,6 @@ def bake_to_file(take: Take, out_path: str, *, rig_path: str | None = None, arma
     save_blend(out_path)
     return {"out": out_path, "armature": obj.name, "preset": result.preset, "action": result.action.name,
             "frames": len(result.motion.frames), "frame_range": list(result.frame_range),
-            "bones": len(result.motion.bone_names), "message": messages[-1] if messages else ""}
+            "bones": len(result.motion.bone_names),
+            "dropped_joint_samples": int(take.metadata.get("dropped_joint_samples", 0)),
+            "message": messages[-1] if messages else ""}

@@ -35,13 +35,9 @@ def numeric_first_row(head: bytes, ncol: int, delimiters: bytes = b"") -> list[b
     return fields
 
 
-def check_rising(path: str, lines: np.ndarray, stamps: np.ndarray, show=lambda t: f"{t:g}") -> None:
-    """TakeError naming the first line whose timestamp does not come after the previous line's."""
-    step = np.diff(stamps)
-    if np.any(step <= 0):
-        i = int(np.argmax(step <= 0)) + 1
-        raise TakeError(f"{path}:{int(lines[i])}: timestamp {show(stamps[i])} is not after the previous "
-                        f"line's {show(stamps[i - 1])}")
+def at(path: str, label: str, where: int) -> str:
+    """Where a message points: `file:line` for line numbers, `file: record N` for other labels."""
+    return f"{path}:{int(where)}" if label == "line" else f"{path}: {label} {int(where)}"
 
 
 def field_counts(data: bytes) -> np.ndarray:
@@ -64,7 +60,8 @@ def parse_table(path: str, data: bytes, ncol: int | None, *, first_line: int = 1
 
     Returns (values, line_numbers) where line_numbers are the 1-based file lines of the rows. `ncol` None
     takes the width of the first non-blank line. Raises TakeError naming the file line for a wrong field
-    count, a non-numeric field or a NaN/infinite value.
+    count or a non-numeric field. NaN and infinite values are returned as they are: a bad joint sample is
+    not structural damage (the readers pass their joints through _screening.screen_joints).
     """
     text = normalise(data, delimiters)
     fast = _fast_table(text, ncol)
@@ -86,12 +83,7 @@ def parse_table(path: str, data: bytes, ncol: int | None, *, first_line: int = 1
         flat = np.fromstring(text.decode("latin-1"), dtype=np.float64, sep=" ")
     if flat.size != rows.size * ncol:
         _raise_non_numeric(path, text, rows, first_line, what)
-    values = flat.reshape(rows.size, ncol)
-    finite = np.isfinite(values)
-    if not finite.all():
-        i = int(rows[np.argmax(~finite.all(axis=1))])
-        raise TakeError(f"{path}:{i + first_line}: NaN or infinite value in {what}")
-    return values, rows + first_line
+    return flat.reshape(rows.size, ncol), rows + first_line
 
 
 def _fast_table(text: bytes, ncol: int | None) -> np.ndarray | None:
@@ -106,7 +98,7 @@ def _fast_table(text: bytes, ncol: int | None) -> np.ndarray | None:
         return None
     if (ncol is not None and values.shape[1] != ncol) or values.shape[0] != body.count(b"\n") + 1:
         return None
-    return values if np.isfinite(values).all() else None
+    return values
 
 
 def _raise_non_numeric(path: str, text: bytes, rows: np.ndarray, first_line: int, what: str) -> None:

@@ -23,6 +23,7 @@ from ..core.skeletons import KINECT_V1, TRACKED
 from ..core.take import Take, TakeError
 from . import bvh_names
 from ._numeric import parse_table, read_bytes
+from ._screening import screen_joints
 
 DEFAULT_CAMERA_DISTANCE = 3.0  # metres in front of the performer's start
 DEFAULT_CAMERA_HEIGHT = 0.8    # metres above the floor: a Kinect on a low table or TV stand
@@ -79,6 +80,7 @@ class BvhMotion:
     # bvh_names.resolve's mapping: {kinect joint: BVH joint indices}, or {family: [unresolved joints]} if
     # the family is None; None until resolved (read_bvh_skeleton resolves it)
     mapping: dict | None = None
+    lines: np.ndarray | None = None  # (F,) the file line of each frame's motion values
 
     @property
     def frame_count(self) -> int:
@@ -323,7 +325,7 @@ def read_bvh_skeleton(path: str | os.PathLike, scale: float | None = None) -> Bv
         raise TakeError(f"{path}:{int(line_numbers[frames])}: more motion lines than 'Frames: {frames}'")
     positions, g_rot = forward_kinematics(sk, values)
     rest, _ = forward_kinematics(sk, np.zeros((1, sk.channel_count)))
-    motion = BvhMotion(path, sk, frame_time, values, positions, g_rot, rest[0])
+    motion = BvhMotion(path, sk, frame_time, values, positions, g_rot, rest[0], lines=line_numbers)
     motion.family, motion.mapping = _family(sk)
     if motion.family is not None:  # unknown skeletons keep the BVH convention, Y up
         motion.up_axis, motion.up_sign = _up_axis(rest[0], motion.mapping)
@@ -378,21 +380,23 @@ def virtual_kinect(motion: BvhMotion, distance: float = DEFAULT_CAMERA_DISTANCE,
         joints = kinect_joints_lab(motion)
     up = np.zeros(3)
     up[motion.up_axis] = motion.up_sign
-    floor = float(np.min(motion.positions_m @ up))
+    floor = float(np.nanmin(motion.positions_m @ up))  # NaN channels (dropped later) must not decide it
     k = KINECT_V1.index
-    left = joints[0, k("HipLeft")] - joints[0, k("HipRight")]
+    hips = joints[:, [k("HipLeft"), k("HipRight"), k("HipCenter")]]
+    first = int(np.argmax(np.all(np.isfinite(hips), axis=(1, 2))))  # frame 0 unless its hips are broken
+    left = joints[first, k("HipLeft")] - joints[first, k("HipRight")]
     left -= up * (left @ up)
     if np.linalg.norm(left) < 1e-9:
         raise TakeError(f"{motion.path}: hips coincide at frame 0; cannot tell which way the performer faces")
     forward = np.cross(left, up)
     forward /= np.linalg.norm(forward)
-    start = joints[0, k("HipCenter")]
+    start = joints[first, k("HipCenter")]
     start = start - up * (start @ up) + up * floor           # on the floor under the hips at frame 0
     z_axis = -forward                                        # the sensor looks back at the performer
     rotation = np.stack([np.cross(up, z_axis), up, z_axis])  # X is the sensor's left
     cam = VirtualKinect(start + forward * distance + up * height, rotation, floor, distance, height)
     if min_range is not None:
-        nearest = float(cam.to_kinect(joints)[..., 2].min())
+        nearest = float(np.nanmin(cam.to_kinect(joints)[..., 2]))
         if nearest < min_range:
             cam.distance += min_range - nearest
             cam.position = cam.position - z_axis * (min_range - nearest)
@@ -409,9 +413,12 @@ def read(path: str | os.PathLike, scale: float | None = None,
     kinect = cam.to_kinect(joints)
     states = np.full(kinect.shape[:2], TRACKED, dtype=np.uint8)
     times = np.arange(motion.frame_count) * motion.frame_time
-    meta = {"source_file": os.path.basename(motion.path), "bvh_family": motion.family,
-            "bvh_units_to_metres": motion.units_to_metres, "virtual_camera": cam.as_dict(),
+    meta = {"source_file": os.path.basename(motion.path), "time_unit": "s (Frame Time)",
+            "bvh_family": motion.family, "bvh_units_to_metres": motion.units_to_metres,
+            "virtual_camera": cam.as_dict(),
             "converted": "optical mocap (BVH) sampled at the Kinect v1 joints by kinect_retarget"}
+    # a NaN channel reaches the joints below it through forward kinematics: those become untracked
+    kinect, states = screen_joints(motion.path, kinect, states, motion.lines, meta)
     try:
         return Take(KINECT_V1, kinect, states, times, _round_rate(1.0 / motion.frame_time), "bvh", meta)
     except TakeError as exc:

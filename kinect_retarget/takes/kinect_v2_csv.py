@@ -1,7 +1,7 @@
 """Kinect v2 CSV as written by Microsoft's KinectReader (LabanotationSuite).
 
 One frame per line: `timestamp, (x, y, z, state) x 25`; timestamp in 100 ns sensor ticks (only differences
-matter), joints in Kinect v2 SDK order, camera space metres, state 0/1/2. Some files end lines with a comma.
+matter; the unit is inferred from the spacing, _timebase, as other tools write ms or s), joints in Kinect v2 SDK order, camera space metres, state 0/1/2. Some files end lines with a comma.
 """
 from __future__ import annotations
 
@@ -11,9 +11,10 @@ import numpy as np
 
 from ..core.skeletons import KINECT_V2, NOT_TRACKED
 from ..core.take import Take, TakeError, nominal_rate
-from ._numeric import check_rising, parse_table, read_bytes
+from ._numeric import parse_table, read_bytes
+from ._screening import screen_joints
+from ._timebase import stamps_to_seconds
 
-TICKS_PER_SECOND = 10_000_000
 NCOL = 1 + 4 * len(KINECT_V2)
 
 
@@ -44,11 +45,10 @@ def make_take(path: str, values: np.ndarray, lines: np.ndarray) -> Take:
     if bad.any():
         i = int(np.argmax(bad.any(axis=1)))
         raise TakeError(f"{path}:{int(lines[i])}: tracking state must be 0, 1 or 2")
-    ticks = values[:, 0]
-    check_rising(path, lines, ticks, show=lambda t: f"{t:.0f}")
     states = states.astype(np.uint8)
     if not np.any(states != NOT_TRACKED):
         raise TakeError(f"{path}: no joint is tracked in any frame")
-    times = (ticks - ticks[0]) / TICKS_PER_SECOND
-    meta = {"source_file": os.path.basename(path), "first_timestamp_ticks": int(ticks[0])}
-    return Take(KINECT_V2, block[..., :3], states, times, nominal_rate(times), "kinect_v2_csv", meta)
+    times, unit = stamps_to_seconds(path, values[:, 0], lines, default="100 ns ticks")
+    meta = {"source_file": os.path.basename(path), "time_unit": unit, "first_timestamp": float(values[0, 0])}
+    positions, states = screen_joints(path, block[..., :3], states, lines, meta)
+    return Take(KINECT_V2, positions, states, times, nominal_rate(times), "kinect_v2_csv", meta)

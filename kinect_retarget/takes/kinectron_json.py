@@ -16,6 +16,9 @@ from ..core.skeletons import KINECT_V2, TRACKED
 from ..core.take import Take, TakeError, nominal_rate
 from ._kinect_v2_images import COLOR_SIZE, DEPTH_SIZE, unmirror
 from ._numeric import read_bytes
+from ._screening import screen_joints
+from ._timebase import stamps_to_seconds
+
 _FIELDS = ("cameraX", "cameraY", "cameraZ", "depthX", "depthY", "colorX", "colorY",
            "orientationW", "orientationX", "orientationY", "orientationZ")
 
@@ -67,19 +70,19 @@ def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
     tracked = states[:, 0] == TRACKED
     if not tracked.any():
         raise TakeError(f"{path}: no tracked body in any of its {n} records")
-    bad = tracked & ~np.all(np.isfinite(table[..., :7]), axis=(1, 2))
-    if bad.any():
-        raise TakeError(f"{path}: record {frames[int(np.argmax(bad))][0]}: NaN or missing joint coordinate")
-    step = np.diff(times)
-    if np.any(step <= 0):
-        i = int(np.argmax(step <= 0)) + 1
-        raise TakeError(f"{path}: record {frames[i][0]}: record_timestamp {times[i]:g} ms is not after "
-                        f"the previous {times[i - 1]:g} ms")
-    times_s = (times - times[0]) / 1000.0
+    records = np.array([rec for rec, _ in frames])
+    times_s, unit = stamps_to_seconds(path, times, records, label="record", what="record_timestamp",
+                                      default="ms")
     first = frames[int(np.argmax(tracked))][1]
-    meta = {"source_file": os.path.basename(path), "record_startime_ms": first.get("record_startime"),
-            "tracking_id": str(first.get("trackingId", "")), "first_record_timestamp_ms": float(times[0])}
-    take = Take(KINECT_V2, table[..., :3], states, times_s, nominal_rate(times_s), "kinectron_json", meta)
+    meta = {"source_file": os.path.basename(path), "time_unit": unit,
+            "record_startime_ms": first.get("record_startime"), "tracking_id": str(first.get("trackingId", "")),
+            "first_timestamp": float(times[0])}
+    # a joint with a NaN or missing image coordinate is as unusable as one with a bad camera position
+    before = states
+    positions, states = screen_joints(path, table[..., :3], states, records, meta, label="record",
+                                      values_ok=np.all(np.isfinite(table[..., 3:7]), axis=2))
+    table[states != before] = np.nan  # dropped samples: their 2D values are not to be trusted either
+    take = Take(KINECT_V2, positions, states, times_s, nominal_rate(times_s), "kinectron_json", meta)
     depth_px, color_px = table[..., 3:5] * DEPTH_SIZE, table[..., 5:7] * COLOR_SIZE
     two_d = {
         "depth": table[..., 3:5], "color": table[..., 5:7], "depth_px": depth_px, "color_px": color_px,

@@ -6,13 +6,15 @@ from __future__ import annotations
 
 import json
 import os
-import warnings
 from typing import IO
 
 import numpy as np
 
 from ..core.skeletons import SKELETONS, Skeleton
 from ..core.take import Take, TakeError
+from ._numeric import parse_table
+from ._screening import screen_joints
+from ._timebase import stamps_to_seconds
 
 MAGIC = "kinect_retarget.take"
 VERSION = 1
@@ -23,9 +25,11 @@ def looks_like(head: bytes) -> bool:
 
 
 def header_dict(skeleton: Skeleton, rate: float, metadata: dict | None = None) -> dict:
+    # `time_unit` describes the file's own time column: the header says it; a source's unit is not carried
+    metadata = {k: v for k, v in (metadata or {}).items() if k != "time_unit"}
     return {"format": MAGIC, "version": VERSION, "skeleton": skeleton.name, "joints": list(skeleton.joints),
             "rate": float(rate), "units": "m", "space": "kinect_camera", "time_unit": "s",
-            "metadata": metadata or {}}
+            "metadata": metadata}
 
 
 def format_rows(times: np.ndarray, positions: np.ndarray, states: np.ndarray) -> str:
@@ -109,14 +113,16 @@ def read(path: str | os.PathLike) -> Take:
         lines.pop()
         warnings_.append(f"{path}:{len(lines) + 2}: last frame line was cut off (interrupted recording); "
                          f"{len(lines)} complete frames loaded")
-    values = _parse_rows(path, lines, ncol, first_line=2)
-    if values.shape[0] == 0:
+    if not lines:
         raise TakeError(f"{path}: take has no frames")
+    values, line_numbers = parse_table(path, "\n".join(lines).encode("utf-8"), ncol, first_line=2,
+                                       what="frame line")
     block = values[:, 1:].reshape(-1, len(skeleton), 4)
     states = block[..., 3]
-    if np.any((states != np.round(states)) | (states < 0) | (states > 2)):
-        bad = int(np.argmax(np.any((states != np.round(states)) | (states < 0) | (states > 2), axis=1)))
-        raise TakeError(f"{path}:{bad + 2}: tracking states must be 0, 1 or 2")
+    bad = ~np.isin(states, (0, 1, 2))
+    if bad.any():
+        raise TakeError(f"{path}:{int(line_numbers[np.argmax(bad.any(axis=1))])}: tracking states must be "
+                        f"0, 1 or 2")
     try:
         rate = float(header.get("rate", 30.0))
     except (TypeError, ValueError):
@@ -124,35 +130,15 @@ def read(path: str | os.PathLike) -> Take:
     metadata = header.get("metadata", {})
     if not isinstance(metadata, dict):
         raise TakeError(f"{path}:1: metadata must be a JSON object")
-    take = _make(path, skeleton, block[..., :3], states.astype(np.uint8), values[:, 0], rate, metadata)
-    if warnings_:
-        take.metadata["warnings"] = warnings_
-    return take
-
-
-def _parse_rows(path: str, lines: list[str], ncol: int, first_line: int) -> np.ndarray:
-    """Parse whitespace-separated numeric rows fast, and name the first bad line when it fails."""
-    # np.fromstring in text mode is the fastest numpy parser; it stops early on a bad token, which the
-    # size check below catches (then the slow path names the line)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)  # "could not be read to its end": bad token
-        flat = np.fromstring("\n".join(lines), sep=" ") if lines else np.empty(0)
-    if flat is not None and flat.size == ncol * len(lines):
-        values = flat.reshape(len(lines), ncol)
-        if np.all(np.isfinite(values)):
-            return values
-    for i, line in enumerate(lines):  # slow path only to name the problem
-        parts = line.split()
-        if len(parts) != ncol:
-            raise TakeError(f"{path}:{i + first_line}: expected {ncol} values, found {len(parts)} "
-                            f"(truncated or corrupt line)")
-        try:
-            row = np.array(parts, dtype=np.float64)
-        except ValueError:
-            raise TakeError(f"{path}:{i + first_line}: non-numeric value in frame line") from None
-        if not np.all(np.isfinite(row)):
-            raise TakeError(f"{path}:{i + first_line}: NaN or infinite value")
-    raise TakeError(f"{path}: could not parse frame lines")
+    metadata = {**metadata, "warnings": list(metadata.get("warnings", [])) + warnings_}
+    # the header declares the unit of the time column (version 1 writes seconds)
+    times, unit = stamps_to_seconds(path, values[:, 0], line_numbers, unit=header.get("time_unit", "s"),
+                                    keep_origin=True)
+    metadata["time_unit"] = unit
+    positions, states = screen_joints(path, block[..., :3], states.astype(np.uint8), line_numbers, metadata)
+    if not metadata["warnings"]:
+        del metadata["warnings"]
+    return _make(path, skeleton, positions, states, times, rate, metadata)
 
 
 def _make(path, skeleton, positions, states, times, rate, metadata) -> Take:

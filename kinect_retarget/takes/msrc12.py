@@ -1,8 +1,10 @@
 """MSRC-12 Kinect gesture data set skeleton files (Kinect v1, 20 joints).
 
-One frame per line, space-separated: a timestamp in seconds, then 20 joints x (x, y, z, w) in Kinect v1
-SDK order, camera space metres (w is the SDK's homogeneous coordinate, 1). A joint whose four values are all
-zero was not tracked; a row of zeros means no skeleton in that frame.
+One frame per line, space-separated (commas accepted): a timestamp, then 20 joints x (x, y, z, w) in Kinect
+v1 SDK order, camera space metres (w is the SDK's homogeneous coordinate, 1). The data set's files stamp
+frames with a microsecond-like counter (e.g. 642926216, ~33,150 per frame); the unit is inferred from the
+spacing (_timebase). A joint whose four values are all zero was not tracked; a row of zeros means no
+skeleton in that frame (the files start with about 20 of them).
 """
 from __future__ import annotations
 
@@ -12,7 +14,9 @@ import numpy as np
 
 from ..core.skeletons import KINECT_V1, NOT_TRACKED, TRACKED
 from ..core.take import Take, TakeError, nominal_rate
-from ._numeric import check_rising, numeric_first_row, parse_table, read_bytes
+from ._numeric import numeric_first_row, parse_table, read_bytes
+from ._screening import screen_joints
+from ._timebase import stamps_to_seconds
 
 NCOL = 1 + 4 * len(KINECT_V1)
 
@@ -28,9 +32,9 @@ def read(path: str | os.PathLike) -> Take:
     states = np.where(np.any(block != 0, axis=2), TRACKED, NOT_TRACKED).astype(np.uint8)
     if not np.any(states != NOT_TRACKED):
         raise TakeError(f"{path}: no joint is tracked in any frame (all rows are zeros)")
-    times = values[:, 0]
-    check_rising(path, lines, times, show=lambda t: f"{t:g} s")
+    rel, unit = stamps_to_seconds(path, values[:, 0], lines)
+    meta = {"source_file": os.path.basename(path), "time_unit": unit, "first_timestamp": float(values[0, 0])}
     positions = np.where(states[..., None] == TRACKED, block[..., :3], np.nan)
-    rel = times - times[0]
-    meta = {"source_file": os.path.basename(path), "first_timestamp_s": float(times[0])}
+    positions, states = screen_joints(path, positions, states, lines, meta,
+                                      values_ok=np.isfinite(block[..., 3]))
     return Take(KINECT_V1, positions, states, rel, nominal_rate(rel), "msrc12", meta)

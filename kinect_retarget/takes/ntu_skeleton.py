@@ -16,6 +16,8 @@ from ..core.skeletons import KINECT_V2, NOT_TRACKED
 from ..core.take import Take, TakeError
 from ._kinect_v2_images import COLOR_SIZE, DEPTH_SIZE, unmirror
 from ._numeric import _raise_non_numeric, field_counts, normalise, read_bytes
+from ._screening import screen_joints
+from ._timebase import FRAME_ORDER
 
 RATE = 30.0
 BODY_FIELDS = 10
@@ -86,10 +88,6 @@ def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
     has = joint_line >= 0
     jl = lines[(joint_line[has, None] + np.arange(len(KINECT_V2))).ravel()]
     vals = flat[start[jl][:, None] + np.arange(JOINT_FIELDS)].reshape(-1, len(KINECT_V2), JOINT_FIELDS)
-    finite = np.isfinite(vals).all(axis=2)
-    if not finite.all():
-        li = int(jl.reshape(-1, len(KINECT_V2))[np.unravel_index(np.argmax(~finite), finite.shape)])
-        raise TakeError(f"{path}:{li + 1}: NaN or infinite value in joint line")
     state_vals = vals[..., 11]
     bad = ~np.isin(state_vals, (0, 1, 2))
     if bad.any():
@@ -103,9 +101,15 @@ def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
     if not np.any(states != NOT_TRACKED):
         raise TakeError(f"{path}: no tracked body in any of its {n_frames} frames")
     times = np.arange(n_frames) / RATE
-    meta = {"source_file": os.path.basename(path), "max_bodies": int(body_count.max()),
+    meta = {"source_file": os.path.basename(path), "time_unit": FRAME_ORDER, "max_bodies": int(body_count.max()),
             "frames_without_body": int(np.sum(~has))}
-    take = Take(KINECT_V2, table[..., :3], states, times, RATE, "ntu_skeleton", meta)
+    where = np.zeros((n_frames, nj), dtype=np.int64)
+    where[has] = jl.reshape(-1, nj) + 1
+    before = states
+    positions, states = screen_joints(path, table[..., :3], states, where, meta,
+                                      values_ok=np.all(np.isfinite(table[..., 3:11]), axis=2))
+    table[states != before] = np.nan  # dropped samples: their 2D values are not to be trusted either
+    take = Take(KINECT_V2, positions, states, times, RATE, "ntu_skeleton", meta)
     depth, color = table[..., 3:5], table[..., 5:7]
     return take, {"depth_px": depth, "color_px": color, "orientation": table[..., 7:11],
                   "depth_px_unmirrored": unmirror(depth, DEPTH_SIZE[0]),

@@ -23,6 +23,8 @@ import numpy as np
 from ..core.skeletons import KINECT_V2, TRACKED
 from ..core.take import Take, TakeError
 from ._numeric import numeric_first_row, parse_table, read_bytes
+from ._screening import screen_joints
+from ._timebase import FRAME_ORDER
 from .bvh import _axis_rotations
 
 RATE = 30.0
@@ -83,8 +85,10 @@ def read(path: str | os.PathLike, sensor_height_cm: float = SENSOR_HEIGHT_CM) ->
         positions[:, KINECT_V2.index(v2)] = kinect[:, NAMES.index(name)]
         states[:, KINECT_V2.index(v2)] = TRACKED
     meta = {"source_file": os.path.basename(pos_path), "angles_file": os.path.basename(ang_path),
-            "assumed_sensor_height_m": sensor_height_cm / 100.0,
+            "time_unit": FRAME_ORDER, "assumed_sensor_height_m": sensor_height_cm / 100.0,
             "untracked_joints": [j for j in KINECT_V2.joints if j not in TO_KINECT_V2]}
+    # a NaN offset or angle reaches the joints below it through the kinematic chain: those become untracked
+    positions, states = screen_joints(pos_path, positions, states, pos_lines, meta)
     return Take(KINECT_V2, positions, states, np.arange(f) / RATE, RATE, "uiprmd", meta)
 
 

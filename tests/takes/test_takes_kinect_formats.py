@@ -46,7 +46,7 @@ def test_kinect_v2_csv_first_line_of_joints(shared_data):
     np.testing.assert_allclose(take.positions[0, 0], [0.0710328, -0.600598, 0.978207])
     np.testing.assert_allclose(take.positions[0, 1], [0.0733363, -0.285628, 0.946217])
     assert take.states[0, 0] == INFERRED and take.states[0, 1] == TRACKED
-    assert take.metadata["first_timestamp_ticks"] == 31867373716
+    assert take.metadata["first_timestamp"] == 31867373716 and take.metadata["time_unit"] == "100 ns ticks"
 
 
 def test_kinectron_json_real_file(shared_data):
@@ -125,7 +125,7 @@ def test_msrc12_fixture(fixtures, shared_data):
     take = msrc12.read(fixtures["msrc12"])
     src = fx.v1_from_v2(kinect_v2_csv.read(shared_data / "kinect_v2" / "joints.csv").slice(slice(0, 60)))
     assert take.skeleton is KINECT_V1 and take.frame_count == 60 and take.rate == 30.0
-    assert take.metadata["first_timestamp_s"] == pytest.approx(0.033333)
+    assert take.metadata["first_timestamp"] == pytest.approx(0.033333) and take.metadata["time_unit"] == "s"
     tracked = src.states != NOT_TRACKED
     np.testing.assert_array_equal(take.states, np.where(tracked, TRACKED, NOT_TRACKED))
     np.testing.assert_allclose(take.positions[tracked], src.positions[tracked], atol=5e-6)
@@ -141,7 +141,7 @@ def test_utkinect_fixture(fixtures, shared_data):
     np.testing.assert_allclose(take.positions, src.positions[keep], atol=5e-6)
     # Frame numbers keep the gaps: frame 7 follows frame 6 after 3 video frames (0.1 s).
     assert take.times[7] - take.times[6] == pytest.approx(3 / 30)
-    assert take.metadata["first_video_frame"] == 248
+    assert take.metadata["first_video_frame"] == 248 and take.metadata["time_unit"] == "frame numbers"
 
 
 def test_utkinect_repeated_frame_numbers(fixtures, tmp_path):

@@ -67,7 +67,6 @@ def test_errors(shared_data, tmp_path):
 
 @pytest.mark.parametrize("how, pattern", [
     ("truncated", r"positions\.txt:13: expected 66 values, found \d+"),
-    ("nan", r"positions\.txt:13: NaN or infinite value"),
     ("garbage", r"positions\.txt:13: non-numeric value 'oops'"),
     ("columns", r"positions\.txt:13: expected 66 values, found 65"),
 ])
