@@ -12,7 +12,7 @@ def live_scene(speed: float, loop: bool = True, filter_name: str = "default"):
     import bpy
 
     import kinect_retarget
-    from kinect_retarget.blender.kinect_rig import build_kinect_rig
+    from kinect_retarget.blender.io.kinect_rig import build_kinect_rig
     from kinect_retarget.core.kinect_rig_layout import median_segment_lengths
     from kinect_retarget.takes import load_take
 
@@ -32,7 +32,7 @@ def pump_like_the_timer(seconds: float, interval: float, on_tick=None) -> None:
     depsgraph update a viewport redraw would do after a pose change."""
     import bpy
 
-    from kinect_retarget.blender import live
+    from kinect_retarget.blender.live import live_controller as live
 
     view_layer = bpy.context.view_layer
     start = time.perf_counter()

@@ -20,10 +20,10 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from kinect_retarget.autorig import autorig, load_mesh  # noqa: E402
-from kinect_retarget.autorig.evaluation import (joint_errors, load_makehuman, pose_body,  # noqa: E402
+from kinect_retarget.sim.autorig_scoring import (joint_errors, load_makehuman, pose_body,  # noqa: E402
                                                 reference_joints, rotations_from_cmu,
                                                 rotations_from_makehuman_bvh, symmetry_error)
-from kinect_retarget.autorig.geodesic import dijkstra  # noqa: E402
+from kinect_retarget.autorig.mesh_geodesic import dijkstra  # noqa: E402
 from kinect_retarget.autorig.graph import mesh_graph  # noqa: E402
 from kinect_retarget.autorig.inside import inside_mesh  # noqa: E402
 from kinect_retarget.autorig.levels import reeb_baseline  # noqa: E402

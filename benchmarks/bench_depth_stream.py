@@ -18,14 +18,14 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from kinect_retarget.device.calibration import Calibration  # noqa: E402
+from kinect_retarget.device.disparity_calibration import Calibration  # noqa: E402
 from kinect_retarget.device.decode import decode_frame  # noqa: E402
-from kinect_retarget.device.depth_images import load_fakenect_dir  # noqa: E402
-from kinect_retarget.device.emulated import EmulatedKinect  # noqa: E402
-from kinect_retarget.device.emulated_stream import DepthPacketizer, EmulatedIsoPump, VirtualClock  # noqa: E402
+from kinect_retarget.sim.depth_sequences import load_fakenect_dir  # noqa: E402
+from kinect_retarget.sim.emulated_kinect import EmulatedKinect  # noqa: E402
+from kinect_retarget.sim.emulated_stream import DepthPacketizer, EmulatedIsoPump, VirtualClock  # noqa: E402
 from kinect_retarget.device.protocol import DEPTH_PACKETS_PER_FRAME  # noqa: E402
 from kinect_retarget.device.reassembly import FrameAssembler  # noqa: E402
-from kinect_retarget.device.stream import DepthStream  # noqa: E402
+from kinect_retarget.device.depth_stream import DepthStream  # noqa: E402
 
 from _common import shared_data_or_skip  # noqa: E402
 
@@ -66,7 +66,7 @@ def emulator_cost_per_second(images) -> float:
     """CPU seconds the emulated device spends producing one second of depth packets."""
     clock = VirtualClock()
     emu = EmulatedKinect(images, clock=clock)
-    from kinect_retarget.device.camera import KinectCamera
+    from kinect_retarget.device.kinect_camera import KinectCamera
     from kinect_retarget.device.discovery import find_kinect
     info = find_kinect(emu)
     camera = KinectCamera(info.camera).open()

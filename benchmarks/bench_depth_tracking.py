@@ -23,9 +23,9 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from kinect_retarget.core.skeletons import KINECT_V1, NOT_TRACKED  # noqa: E402
-from kinect_retarget.depth.evaluation import facing_angle, score  # noqa: E402
-from kinect_retarget.depth.synthetic import Scenario, render_sequence  # noqa: E402
-from kinect_retarget.depth.tracker import SkeletonTracker  # noqa: E402
+from kinect_retarget.sim.depth_scoring import facing_angle, score  # noqa: E402
+from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence  # noqa: E402
+from kinect_retarget.depth.skeleton_tracker import SkeletonTracker  # noqa: E402
 
 from _common import shared_data_or_skip  # noqa: E402
 

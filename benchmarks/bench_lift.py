@@ -19,8 +19,8 @@ sys.path.insert(0, str(REPO))
 from kinect_retarget.core.skeletons import KINECT_V1, KINECT_V2, V1_FROM_V2  # noqa: E402
 from kinect_retarget.core.take import Take  # noqa: E402
 from kinect_retarget.lift.bones import lengths_from_take, standing_height  # noqa: E402
-from kinect_retarget.lift.camera import Camera, view_points  # noqa: E402
-from kinect_retarget.lift.evaluation import (mpjpe, procrustes_align, root_relative,  # noqa: E402
+from kinect_retarget.lift.video_camera import Camera, view_points  # noqa: E402
+from kinect_retarget.sim.lift_scoring import (mpjpe, procrustes_align, root_relative,  # noqa: E402
                                              sign_flip_fraction, tracks_from_take)
 from kinect_retarget.lift.lifter import LiftSettings, lift  # noqa: E402
 from kinect_retarget.lift.tracks2d import Tracks2D  # noqa: E402

@@ -16,9 +16,9 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from kinect_retarget.core.skeletons import KINECT_V1  # noqa: E402
-from kinect_retarget.lift.camera import Camera, view_points  # noqa: E402
-from kinect_retarget.lift.render import background, render  # noqa: E402
-from kinect_retarget.lift.tracker import JointTracker, TrackerSettings  # noqa: E402
+from kinect_retarget.lift.video_camera import Camera, view_points  # noqa: E402
+from kinect_retarget.sim.body_imagery import background, render  # noqa: E402
+from kinect_retarget.lift.joint_tracker import JointTracker, TrackerSettings  # noqa: E402
 from kinect_retarget.takes import bvh  # noqa: E402
 
 from _common import shared_data_or_skip  # noqa: E402

@@ -185,9 +185,9 @@ def run_job(job: Job, out: Path, args: argparse.Namespace, rigify_base: str | No
     import bpy
 
     from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
-    from kinect_retarget.blender.body_mesh import add_body_mesh
+    from tools.demo_body import add_body_mesh
     from kinect_retarget.blender.headless import save_blend
-    from kinect_retarget.blender.render import contact_sheet, stage, stage_and_render
+    from kinect_retarget.blender.io.workbench_render import contact_sheet, stage, stage_and_render
 
     result = Outcome(job)
     take = read_take(job)

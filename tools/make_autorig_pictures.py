@@ -24,8 +24,8 @@ import bpy  # noqa: E402
 from kinect_retarget.assets import MAKEHUMAN_DIR  # noqa: E402
 from kinect_retarget.autorig import Mesh, autorig, load_mesh  # noqa: E402
 from kinect_retarget.autorig.orient import upright_transform  # noqa: E402
-from kinect_retarget.blender.autorig_op import autorig_to_file, new_mesh_object  # noqa: E402
-from kinect_retarget.blender.render import render_still, stage  # noqa: E402
+from kinect_retarget.blender.mesh_autorig import autorig_to_file, new_mesh_object  # noqa: E402
+from kinect_retarget.blender.io.workbench_render import render_still, stage  # noqa: E402
 from kinect_retarget.takes import load_take  # noqa: E402
 
 

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geodesic import dijkstra
+from .mesh_geodesic import dijkstra
 from .graph import MeshGraph
 from .mesh import MeshError
 

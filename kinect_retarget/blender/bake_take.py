@@ -14,11 +14,11 @@ from ..core.pipeline import BakedMotion, RetargetPipeline, RetargetSettings
 from ..core.presets import build_mapping, mapping_problems
 from ..core.skeletons import Skeleton
 from ..core.take import Take
-from .bake import bake_motion
-from .evaluated_solve import correct_for_evaluation
-from .kinect_rig import build_kinect_rig
-from .pose_apply import restore_pose, snapshot_pose
-from .rig_reader import fk_switch_bones, has_constrained_ancestry, target_rig_from_object
+from .io.action_writer import bake_motion
+from .io.evaluated_solve import correct_for_evaluation
+from .io.kinect_rig import build_kinect_rig
+from .io.pose_apply import restore_pose, snapshot_pose
+from .io.rig_reader import fk_switch_bones, has_constrained_ancestry, target_rig_from_object
 
 Report = Callable[[set, str], None]
 

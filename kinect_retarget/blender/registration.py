@@ -1,43 +1,35 @@
-"""One ordered class list; unregister undoes everything in mirror order. Feature modules under blender/
-expose their own CLASSES and optional register_extra()/unregister_extra() hooks (timers, handlers)."""
+"""One static class list, registered in order; unregister is its mirror. Property groups come before the
+classes that point at them, and the main panel before its sub-panels. After the classes, the hooks
+(scene properties, handlers, menus, the USB source) are added in order and removed in reverse."""
 from __future__ import annotations
-
-from importlib import import_module
 
 import bpy
 
-# Modules in registration order (property groups before the classes that point at them).
-MODULES = ("operators",)
-OPTIONAL_MODULES = ("preferences", "properties", "live", "mapping_ui", "panels", "usb_panel", "autorig_op", "lift_op")
+from . import clip_lift, mesh_autorig
+from .live import live_controller, usb_service
+from .ui import bake_operator, mapping_table, panels, preferences, properties
 
-_registered: list = []
-_hooks: list = []
+CLASSES = (*bake_operator.CLASSES, *preferences.CLASSES, *properties.CLASSES, *live_controller.CLASSES,
+           *mapping_table.CLASSES, *panels.CLASSES, *usb_service.CLASSES, *mesh_autorig.CLASSES,
+           *clip_lift.CLASSES)
+HOOKS = (properties, live_controller, usb_service, mesh_autorig, clip_lift)   # register_extra/unregister_extra
 
-
-def _modules():
-    mods = [import_module(f".{m}", __package__) for m in MODULES]
-    for name in OPTIONAL_MODULES:
-        try:
-            mods.append(import_module(f".{name}", __package__))
-        except ModuleNotFoundError as exc:
-            if exc.name != f"{__package__}.{name}":  # a real import error inside the module
-                raise
-    return mods
+_done = {"classes": 0, "hooks": 0}   # how far register() got, so unregister() undoes exactly that
 
 
 def register() -> None:
-    for mod in _modules():
-        for cls in getattr(mod, "CLASSES", ()):
-            bpy.utils.register_class(cls)
-            _registered.append(cls)
-        hook = getattr(mod, "register_extra", None)
-        if hook:
-            hook()
-            _hooks.append(mod)
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+        _done["classes"] += 1
+    for mod in HOOKS:
+        mod.register_extra()
+        _done["hooks"] += 1
 
 
 def unregister() -> None:
-    while _hooks:
-        _hooks.pop().unregister_extra()
-    while _registered:
-        bpy.utils.unregister_class(_registered.pop())
+    while _done["hooks"]:
+        _done["hooks"] -= 1
+        HOOKS[_done["hooks"]].unregister_extra()
+    while _done["classes"]:
+        _done["classes"] -= 1
+        bpy.utils.unregister_class(CLASSES[_done["classes"]])

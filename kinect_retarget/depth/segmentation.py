@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.conventions import depth_pixel_to_kinect, kinect_to_depth_pixel
-from .camera import DepthCamera
+from .depth_camera import DepthCamera
 
 MIN_Z, MAX_Z = 0.5, 4.5
 

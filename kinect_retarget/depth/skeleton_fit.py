@@ -20,7 +20,7 @@ from ..core.skeletons import INFERRED, NOT_TRACKED, TRACKED
 from . import body_model_fit as bm
 from .arm_search import SIDES, J, TorsoFrame, fit_arms
 from .facing import chest_facing
-from .geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
+from .surface_geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
 from .limb_ends import at_image_border, occluded_end
 from .sides import assign_sides
 from .two_bone import two_bone_candidates

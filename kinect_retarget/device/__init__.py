@@ -1,4 +1,4 @@
-"""Kinect v1 over USB in pure Python (pyusb + numpy): discovery, depth stream, motor, emulated device.
+"""Kinect v1 over USB in pure Python (pyusb + numpy): discovery, depth stream, motor (the emulated Kinect lives in sim/).
 
 The API the rest of the extension uses (no bpy anywhere in this package):
 
@@ -7,19 +7,16 @@ The API the rest of the extension uses (no bpy anywhere in this package):
     DepthStream.status -> StreamStatus                    state text, message, fps, frames, dropped frames
     set_tilt(angle) / open_motor().set_led(mode) / .state()
     depth_preview(frame.mm) -> (120, 160) uint8           for a live preview image
-    EmulatedKinect(images, faults=Faults(...))           an emulated Kinect (pyusb backend) for tests/demo
 """
-from .calibration import Calibration
+from .disparity_calibration import Calibration
 from .discovery import KinectInfo, find_kinect, list_devices
-from .emulated import EmulatedKinect
-from .emulated_stream import Faults, VirtualClock
 from .errors import (AccessDenied, BadInputFile, DeviceGone, DeviceNotFound, DumpError, KinectError, LibusbMissing,
                      MotorUnavailable, ProtocolError)
 from .motor import KinectMotor, MotorState, open_motor, set_tilt
-from .preview import depth_preview
-from .stream import DepthFrame, DepthStream, StreamStatus
+from .depth_preview import depth_preview
+from .depth_stream import DepthFrame, DepthStream, StreamStatus
 
-__all__ = ["Calibration", "KinectInfo", "find_kinect", "list_devices", "EmulatedKinect", "Faults",
-           "VirtualClock", "AccessDenied", "BadInputFile", "DeviceGone", "DeviceNotFound", "DumpError", "KinectError",
+__all__ = ["Calibration", "KinectInfo", "find_kinect", "list_devices",
+           "AccessDenied", "BadInputFile", "DeviceGone", "DeviceNotFound", "DumpError", "KinectError",
            "LibusbMissing", "MotorUnavailable", "ProtocolError", "KinectMotor", "MotorState", "open_motor",
            "set_tilt", "depth_preview", "DepthFrame", "DepthStream", "StreamStatus"]

@@ -11,7 +11,7 @@ import usb.core
 import usb.util
 
 from . import protocol as P
-from .camera import access_advice, is_gone
+from .kinect_camera import access_advice, is_gone
 from .errors import DeviceNotFound, LibusbMissing
 from .usb_backend import find_backend
 

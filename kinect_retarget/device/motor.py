@@ -14,7 +14,7 @@ import usb.core
 import usb.util
 
 from . import protocol as P
-from .camera import access_advice, is_gone
+from .kinect_camera import access_advice, is_gone
 from .discovery import KinectInfo, find_kinect
 from .errors import AccessDenied, DeviceGone, MotorUnavailable, ProtocolError
 

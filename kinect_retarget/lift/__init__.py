@@ -27,7 +27,7 @@ def detect_2d_format(path: str) -> str:
 
 
 def read_2d(path: str | os.PathLike, fmt: str = "auto", fps: float = 30.0, image_size=None) -> Tracks2D:
-    """Keypoint files -> Tracks2D on the Kinect v1 joints ("clip" needs Blender: blender/lift_op.py)."""
+    """Keypoint files -> Tracks2D on the Kinect v1 joints ("clip" needs Blender: blender/clip_lift.py)."""
     path = os.fspath(path)
     if not os.path.exists(path):
         raise LiftError(f"{path}: no such file or folder")

@@ -1,6 +1,6 @@
 """2D tracks from named point tracks (Blender Movie Clip tracking, or anything shaped like it).
 
-The Blender side (blender/lift_op.py) only copies each track's markers out as arrays; everything else
+The Blender side (blender/clip_lift.py) only copies each track's markers out as arrays; everything else
 (naming, frame range, joints derived from others) is here, without bpy.
 """
 from __future__ import annotations

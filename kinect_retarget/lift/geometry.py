@@ -6,8 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .camera import Camera
-from .depth import depth_magnitude
+from .video_camera import Camera
+from .bone_depth import depth_magnitude
 
 
 @dataclass

@@ -15,8 +15,8 @@ import numpy as np
 from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED, topological_order
 from ..core.take import Take, nominal_rate
 from .bones import DEFAULT_HEIGHT_M, lengths_from_height
-from .camera import Camera
-from .depth import jitter_px
+from .video_camera import Camera
+from .bone_depth import jitter_px
 from .gaps import fill_gaps
 from .geometry import JointLines
 from .scale import SCALE_BONES, fill_missing, smooth_lengths, scale_envelope, scale_lower_bound, scale_paper

@@ -14,8 +14,8 @@ from typing import Callable
 import numpy as np
 
 from ..core.skeletons import NOT_TRACKED
-from .calibration import CalibrationCapture
-from .queueing import FrameQueue
+from ..core.performer_calibration import CalibrationCapture
+from ..sources.frame_queue import FrameQueue
 from .recording import Recorder
 from .stats import LiveStats
 

@@ -1,10 +1,12 @@
-"""Frame sources (take playback, OSC, USB Kinect): each a thread putting whole frames on a FrameQueue."""
+"""Frame sources: the frame type (skeleton_frame), the bounded queue (frame_queue), the source protocol
+(frame_source), and the sources themselves (take playback, OSC, the USB Kinect through the depth tracker),
+each a thread putting whole frames on a FrameQueue."""
 from __future__ import annotations
 
-from .base import FrameSource, SourceError
-from .osc import OscReceiver
-from .playback import TakePlayback
-from .usb import UsbKinectSource
+from .frame_source import FrameSource, SourceError
+from .osc_receiver import OscReceiver
+from .take_playback import TakePlayback
+from .usb_kinect import UsbKinectSource
 
 
 def open_source(spec: str, speed: float = 1.0, loop: bool = False, host: str = "127.0.0.1",
@@ -22,7 +24,7 @@ def open_source(spec: str, speed: float = 1.0, loop: bool = False, host: str = "
         return OscReceiver(port, host=host)
     if kind == "usb" and not arg:
         if simulate:
-            from ..depth.producer import open_skeleton_producer
+            from .depth_skeletons import open_skeleton_producer
             return UsbKinectSource(factory=lambda: open_skeleton_producer(simulate=True))
         return UsbKinectSource()
     raise SourceError(f"unknown source {spec!r}: use take:FILE, osc:PORT or usb")

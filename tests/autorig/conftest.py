@@ -1,7 +1,7 @@
 """The MakeHuman base mesh and its reference skeleton, loaded once for the auto-rig tests (none changes it)."""
 import pytest
 
-from kinect_retarget.autorig.evaluation import load_makehuman
+from kinect_retarget.sim.autorig_scoring import load_makehuman
 
 
 @pytest.fixture(scope="session")

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from kinect_retarget.autorig import MeshError, autorig
-from kinect_retarget.autorig.evaluation import (joint_errors, pose_body, reference_joints,
+from kinect_retarget.sim.autorig_scoring import (joint_errors, pose_body, reference_joints,
                                                 rotations_from_cmu, rotations_from_makehuman_bvh, symmetry_error)
 from kinect_retarget.autorig.features import LABELS
 from kinect_retarget.autorig.inside import inside_mesh

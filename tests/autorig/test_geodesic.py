@@ -1,6 +1,6 @@
 import numpy as np
 
-from kinect_retarget.autorig.geodesic import dijkstra
+from kinect_retarget.autorig.mesh_geodesic import dijkstra
 from kinect_retarget.autorig.graph import connected_components, mesh_graph
 from tests.autorig.shapes import grid_mesh
 

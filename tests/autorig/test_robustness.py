@@ -2,7 +2,7 @@
 import numpy as np
 
 from kinect_retarget.autorig import autorig
-from kinect_retarget.autorig.evaluation import (joint_errors, pose_body, reference_joints,
+from kinect_retarget.sim.autorig_scoring import (joint_errors, pose_body, reference_joints,
                                                 rotations_from_makehuman_bvh)
 from kinect_retarget.autorig.mesh import Mesh, subdivide
 from kinect_retarget.core.skeletons import KINECT_V1

@@ -41,7 +41,7 @@ def test_blender_exported_files_rig_like_the_source(bpy_empty, shared_data, tmp_
     import numpy as np
 
     from kinect_retarget.autorig import autorig, load_mesh
-    from kinect_retarget.blender.autorig_op import new_mesh_object
+    from kinect_retarget.blender.mesh_autorig import new_mesh_object
     bpy = bpy_empty
     src = load_mesh(shared_data / "meshes" / "makehuman" / "base.obj", group="body")
     z_up = src.vertices @ np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], float).T * 0.1

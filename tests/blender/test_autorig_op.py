@@ -15,7 +15,7 @@ def body(shared_data):
 
 
 def _add_body(bpy, body, location=(0.0, 0.0, 0.0)):
-    from kinect_retarget.blender.autorig_op import new_mesh_object
+    from kinect_retarget.blender.mesh_autorig import new_mesh_object
     obj = new_mesh_object("Body", body[0], body[1], bpy.context.scene.collection)
     obj.location = location
     bpy.context.view_layer.update()
@@ -76,7 +76,7 @@ def test_not_a_human_leaves_scene_untouched(registered, shape, message):
 
 def test_take_baked_on_autorigged_mesh_deforms_cleanly(registered, body, shared_data):
     bpy = registered
-    from kinect_retarget.blender.autorig_op import rig_mesh_object
+    from kinect_retarget.blender.mesh_autorig import rig_mesh_object
     from kinect_retarget.blender.bake_take import bake_take
     from kinect_retarget.takes import load_take
     obj = _add_body(bpy, body)
@@ -120,7 +120,7 @@ def test_heat_weights_option(registered, body):
 def test_other_selected_meshes_are_bound(registered, body):
     """A garment kept as its own object (here: a shell around the left arm) follows the same rig."""
     bpy = registered
-    from kinect_retarget.blender.autorig_op import new_mesh_object
+    from kinect_retarget.blender.mesh_autorig import new_mesh_object
     v, f = body
     left_arm = v[:, 0] > 0.25
     keep = left_arm[f].all(axis=1)
@@ -145,7 +145,7 @@ def test_other_selected_meshes_are_bound(registered, body):
 def test_failure_after_armature_is_rolled_back(registered, body, monkeypatch):
     """If anything fails half-way (here: writing the weights), the mesh is left exactly as it was."""
     bpy = registered
-    from kinect_retarget.blender import autorig_op
+    from kinect_retarget.blender import mesh_autorig as autorig_op
     obj = _add_body(bpy, body, location=(0.5, 0.0, 0.0))
     obj.vertex_groups.new(name="mine")
 

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
-from kinect_retarget.blender.body_mesh import add_body_mesh, body_bones, bone_radius
-from kinect_retarget.blender.render import stage_and_render
+from tools.demo_body import add_body_mesh, body_bones, bone_radius
+from kinect_retarget.blender.io.workbench_render import stage_and_render
 from kinect_retarget.takes import kinect_v2_csv
 
 WAVE_FRAME = 60  # Ges01: the performer's right hand is up, waving, around here

@@ -48,7 +48,10 @@ def test_zip_has_manifest_package_and_every_platforms_wheels(extension_zip):
         names = set(zf.namelist())
         manifest = tomllib.loads(zf.read("blender_manifest.toml").decode())
     assert extension_zip.name == f"kinect_retarget-{manifest['version']}.zip"
-    assert {"__init__.py", "blender/registration.py", "live/session.py", "sources/osc.py"} <= names
+    assert {"__init__.py", "blender/registration.py", "live/session.py", "sources/osc_receiver.py"} <= names
+    package = Path(__file__).resolve().parents[2] / "kinect_retarget"
+    every_module = {str(f.relative_to(package)) for f in package.rglob("*.py") if "__pycache__" not in f.parts}
+    assert every_module <= names, sorted(every_module - names)   # every subpackage ships
     assert not any("__pycache__" in n for n in names)
     listed = {w.removeprefix("./") for w in manifest["wheels"]}
     assert listed == {n for n in names if n.startswith("wheels/")}
@@ -82,8 +85,8 @@ def test_register_unregister_three_times_leaves_nothing(shared_data, tmp_path):
     """In process, the plain package: cycles with live running in between."""
     import bpy
     import kinect_retarget
-    from kinect_retarget.blender import live
-    from kinect_retarget.blender.kinect_rig import build_kinect_rig
+    from kinect_retarget.blender.live import live_controller as live
+    from kinect_retarget.blender.io.kinect_rig import build_kinect_rig
     from kinect_retarget.core.kinect_rig_layout import median_segment_lengths
     from kinect_retarget.takes import load_take
 
@@ -109,7 +112,7 @@ def leftovers(bpy, timer_fns=()) -> dict:
                 for f in (getattr(bpy.app.handlers, name) if isinstance(getattr(bpy.app.handlers, name), list)
                           else []) if "kinect_retarget" in getattr(f, "__module__", "")]
     fns = list(timer_fns) + [sys.modules[n]._timer for n in list(sys.modules)
-                             if n.endswith("kinect_retarget.blender.live")]
+                             if n.endswith("kinect_retarget.blender.live.live_controller")]
     timers = any(bpy.app.timers.is_registered(f) for f in fns)
     threads = [t.name for t in threading.enumerate() if t.name.startswith("kinect_retarget") and t.is_alive()]
     return {"classes": classes, "timers": timers, "handlers": handlers, "threads": threads}
@@ -129,7 +132,7 @@ def _child(zip_path: str, take_path: str) -> None:
     prefs = bpy.context.preferences.addons[EXT].preferences
     out["prefs"] = [prefs.osc_port, prefs.osc_listen_all, prefs.default_source]
     pkg = importlib.import_module(EXT)
-    rig_mod = importlib.import_module(EXT + ".blender.kinect_rig")
+    rig_mod = importlib.import_module(EXT + ".blender.io.kinect_rig")
     layout = importlib.import_module(EXT + ".core.kinect_rig_layout")
     take = importlib.import_module(EXT + ".takes").load_take(take_path)
     obj = rig_mod.build_kinect_rig(bpy.context.scene, take.skeleton, layout.median_segment_lengths(take), "Rig")
@@ -141,7 +144,7 @@ def _child(zip_path: str, take_path: str) -> None:
     # live through the installed package, then disable while it runs
     s = bpy.context.scene.kinect_retarget
     s.source, s.take_path, s.loop, s.initialised = "TAKE", take_path, True, True
-    live = importlib.import_module(EXT + ".blender.live")
+    live = importlib.import_module(EXT + ".blender.live.live_controller")
     live.start_live(bpy.context, use_timer=True)
     live.pump_live()
     timer = live._timer

@@ -7,8 +7,8 @@ import pytest
 
 from kinect_retarget.core.conventions import kinect_to_blender
 from kinect_retarget.core.skeletons import KINECT_V1
-from kinect_retarget.lift.camera import Camera, view_points
-from kinect_retarget.lift.frames import write_png
+from kinect_retarget.lift.video_camera import Camera, view_points
+from kinect_retarget.lift.image_sequence import write_png
 from kinect_retarget.takes import bvh
 
 W, H, FOCAL = 640, 360, 520.0
@@ -49,7 +49,7 @@ def _clip(bpy, tmp_path, uv, names=TRACK_NAMES, first=1):
 
 
 def test_clip_markers_read_back_as_pixels(bpy_empty, tmp_path, walk_2d):
-    from kinect_retarget.blender.lift_op import clip_focal_px, tracks_from_clip
+    from kinect_retarget.blender.clip_lift import clip_focal_px, tracks_from_clip
     pos, uv = walk_2d
     clip = _clip(bpy_empty, tmp_path, uv)
     assert clip_focal_px(clip) == pytest.approx(FOCAL, rel=1e-4)
@@ -157,7 +157,7 @@ def _hanim_rig(bpy, rest_kinect: np.ndarray):
 
 
 def test_lift_bakes_onto_an_hanim_humanoid(bpy_empty, tmp_path, walk_2d, shared_data):
-    from kinect_retarget.blender.lift_op import lift_clip_and_bake
+    from kinect_retarget.blender.clip_lift import lift_clip_and_bake
     bpy = bpy_empty
     pos, uv = walk_2d
     clip = _clip(bpy, tmp_path, uv)
@@ -178,7 +178,7 @@ def test_lift_bakes_onto_an_hanim_humanoid(bpy_empty, tmp_path, walk_2d, shared_
 def test_joint_tracker_writes_clip_markers(registered, tmp_path, shared_data):
     """Paper 004's tracker inside Blender: markers on frame 1 of an image-sequence clip of a rendered
     coloured body (real motion), followed through the clip."""
-    from kinect_retarget.lift.render import background, render
+    from kinect_retarget.sim.body_imagery import background, render
     bpy = registered
     take = bvh.read(shared_data / "mocap_bvh" / "131_02.bvh")
     pos = view_points(take.positions[::4][150:165], 80.0, 5.0, 3.5, take.positions[600, 0])

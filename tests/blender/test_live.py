@@ -11,15 +11,15 @@ import numpy as np
 import pytest
 
 import kinect_retarget
-from kinect_retarget.blender import live
-from kinect_retarget.blender.kinect_rig import build_kinect_rig
+from kinect_retarget.blender.live import live_controller as live
+from kinect_retarget.blender.io.kinect_rig import build_kinect_rig
 from kinect_retarget.core.kinect_rig_layout import median_segment_lengths
 from kinect_retarget.core.quat import angle_between
 from kinect_retarget.core.skeletons import KINECT_V2
 from kinect_retarget.core.take import Take
-from kinect_retarget.live.calibration import PROPERTY as CALIBRATION
+from kinect_retarget.core.performer_calibration import PROPERTY as CALIBRATION
 from kinect_retarget.sources import TakePlayback
-from kinect_retarget.sources.base import FrameSource
+from kinect_retarget.sources.frame_source import FrameSource
 from kinect_retarget.takes import krtake
 
 REPO_SAMPLE = Path(__file__).resolve().parents[2] / "sample_takes" / "kinect_v2_ges03_drawlines.krtake"
@@ -232,7 +232,7 @@ def test_loading_a_file_stops_live(scene_with_rig, tmp_path):
 
 
 def test_live_operators_push_no_undo_steps_and_show_in_search(registered):
-    from kinect_retarget.blender.live import CLASSES
+    from kinect_retarget.blender.live.live_controller import CLASSES
     for cls in CLASSES:
         assert "UNDO" not in cls.bl_options, cls.bl_idname
         assert cls.bl_idname.startswith("kinect_retarget.") and cls.__doc__  # F3 search shows label + tooltip
@@ -350,7 +350,7 @@ def test_start_live_operator_reports_a_missing_take_and_leaves_nothing_running(s
 def test_sidebar_tab_and_preferences_are_registered(registered):
     assert bpy.types.KINECT_RETARGET_PT_main.bl_category == "Kinect"
     assert bpy.types.KINECT_RETARGET_PT_main.bl_space_type == "VIEW_3D"
-    from kinect_retarget.blender.preferences import ADDON_ID, KinectRetargetPreferences
+    from kinect_retarget.blender.ui.preferences import ADDON_ID, KinectRetargetPreferences
     assert KinectRetargetPreferences.bl_idname == ADDON_ID == "kinect_retarget"
 
 

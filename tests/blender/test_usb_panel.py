@@ -15,13 +15,14 @@ import pytest
 
 import kinect_retarget
 from kinect_retarget.core.kinect_rig_layout import typical_segment_lengths
-from kinect_retarget.blender import live, usb_panel
-from kinect_retarget.blender.kinect_rig import build_kinect_rig
+from kinect_retarget.blender.live import live_controller as live, usb_service as usb_panel
+from kinect_retarget.blender.io.kinect_rig import build_kinect_rig
 from kinect_retarget.core.skeletons import KINECT_V1
-from kinect_retarget.device import EmulatedKinect, LibusbMissing, list_devices, open_motor
-from kinect_retarget.device.calibration import Calibration
-from kinect_retarget.device.depth_images import load_fakenect_dir
-from kinect_retarget.device.emulated import DEFAULT_SERIAL
+from kinect_retarget.device import LibusbMissing, list_devices, open_motor
+from kinect_retarget.sim.emulated_kinect import EmulatedKinect
+from kinect_retarget.device.disparity_calibration import Calibration
+from kinect_retarget.sim.depth_sequences import load_fakenect_dir
+from kinect_retarget.sim.emulated_kinect import DEFAULT_SERIAL
 from kinect_retarget.sources import SourceError
 
 FAKENECT = ("depth_real", "fakenect_openiss", "fakenect-record")
@@ -177,7 +178,7 @@ def test_depth_stream_preview_updates_the_image(registered, fakenect_frames):
 @pytest.fixture
 def rendered_frames(tmp_path_factory, monkeypatch):
     """Six frames of CMU mocap rendered as Kinect depth (the simulated Kinect's own content), cached."""
-    from kinect_retarget.depth.producer import simulated_frames
+    from kinect_retarget.sources.simulated_kinect import simulated_frames
     monkeypatch.setenv("KR_DEPTH_CACHE", str(tmp_path_factory.getbasetemp() / "depth_cache"))
     return simulated_frames(6)   # from the package's own assets
 

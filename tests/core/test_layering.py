@@ -29,7 +29,7 @@ def test_no_blender_imports_outside_blender_package():
     assert not offenders, "Blender imports outside kinect_retarget/blender/: " + "; ".join(offenders)
 
 
-PURE_PACKAGES = ("core", "takes", "device", "sources", "live", "depth", "autorig", "lift")
+PURE_PACKAGES = ("core", "takes", "device", "sources", "live", "depth", "autorig", "lift", "sim")
 
 
 def _relative_targets(path: Path):
@@ -50,6 +50,36 @@ def test_pure_packages_never_reach_the_blender_package():
             if bad:
                 offenders.append(f"{path.relative_to(PACKAGE)}: {bad}")
     assert not offenders, "bpy-free packages importing kinect_retarget.blender: " + "; ".join(offenders)
+
+
+def _all_targets(path: Path):
+    """Absolute names of every import in a file, relative or absolute, at any depth; `from X import y` gives
+    X and X.y (y may be a module)."""
+    package = list(path.relative_to(PACKAGE.parent).with_suffix("").parts[:-1])
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            yield from (a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            base = package[: len(package) - node.level + 1] if node.level else []
+            module = ".".join(base + ([node.module] if node.module else []))
+            yield module
+            yield from (f"{module}.{a.name}" for a in node.names)
+
+
+# the simulated Kinect is a product feature reached through this one module; nothing else ships sim/ code paths
+SIM_ENTRY_POINT = Path("sources/simulated_kinect.py")
+
+
+def test_only_sim_and_the_simulated_device_entry_point_import_sim():
+    offenders = []
+    for path in PACKAGE.rglob("*.py"):
+        rel = path.relative_to(PACKAGE)
+        if rel.parts[0] == "sim" or rel == SIM_ENTRY_POINT:
+            continue
+        bad = [t for t in _all_targets(path) if t == "kinect_retarget.sim" or t.startswith("kinect_retarget.sim.")]
+        if bad:
+            offenders.append(f"{rel}: {bad}")
+    assert not offenders, "modules outside sim/ importing sim/: " + "; ".join(offenders)
 
 
 def test_core_imports_without_bpy():

@@ -7,7 +7,7 @@ import pytest
 
 @pytest.fixture(scope="session")
 def rendered(shared_data, tmp_path_factory):
-    from kinect_retarget.depth.synthetic import Scenario, render_sequence
+    from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence
     seq = render_sequence(str(shared_data / "mocap_bvh" / "131_03.bvh"), str(shared_data / "meshes" / "makehuman"),
                           Scenario(seed=7), start=40, frames=12)
     path = tmp_path_factory.mktemp("depth") / "hop.npz"
@@ -17,7 +17,7 @@ def rendered(shared_data, tmp_path_factory):
 
 @pytest.fixture
 def camera():
-    from kinect_retarget.depth.camera import DepthCamera
+    from kinect_retarget.depth.depth_camera import DepthCamera
     return DepthCamera()
 
 

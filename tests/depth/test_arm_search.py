@@ -12,14 +12,14 @@ import pytest
 from kinect_retarget.core.skeletons import KINECT_V1, TRACKED
 from kinect_retarget.depth import arm_search, skeleton_fit
 from kinect_retarget.depth.arm_search import DIRECTIONS, search_arm
-from kinect_retarget.depth.tracker import SkeletonTracker
+from kinect_retarget.depth.skeleton_tracker import SkeletonTracker
 
 HAND_R, ELBOW_R = KINECT_V1.index("HandRight"), KINECT_V1.index("ElbowRight")
 
 
 @pytest.fixture(scope="module")
 def hand_on_face(shared_data):
-    from kinect_retarget.depth.synthetic import Scenario, render_sequence
+    from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence
     return render_sequence(str(shared_data / "mocap_bvh" / "131_02.bvh"), str(shared_data / "meshes" / "makehuman"),
                            Scenario(seed=5), start=400, frames=3)
 
@@ -122,7 +122,7 @@ def test_the_head_is_not_arm_evidence(hand_on_face, monkeypatch):
 def test_well_explained_arms_of_a_performer_facing_the_sensor_are_tracked(shared_data, monkeypatch):
     """Walking toward the sensor with the hands hanging (no extremity): once the tracking is steady, the
     search's elbows and wrists that the surface shows are reported tracked, and they are right."""
-    from kinect_retarget.depth.synthetic import Scenario, render_sequence
+    from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence
     seq = render_sequence(str(shared_data / "mocap_bvh" / "131_02.bvh"), str(shared_data / "meshes" / "makehuman"),
                           Scenario(seed=5), start=0, frames=16)
     arm = [KINECT_V1.index(f"{j}{s}") for j in ("Elbow", "Wrist") for s in ("Left", "Right")]

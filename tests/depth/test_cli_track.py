@@ -65,7 +65,7 @@ def test_all_zero_capture_gives_an_untracked_take(tmp_path):
 
 def test_track_replays_a_usb_packet_dump(rendered, tmp_path):
     from kinect_retarget.device.dump import DumpWriter
-    from kinect_retarget.device.emulated_stream import packets_for_frames
+    from kinect_retarget.sim.emulated_stream import packets_for_frames
     seq, _ = rendered
     dump = tmp_path / "capture.dump"
     with DumpWriter(dump) as w:
@@ -87,9 +87,9 @@ def test_track_replays_a_usb_packet_dump(rendered, tmp_path):
 def test_replayed_frame_with_a_lost_packet_does_not_pass_filler_for_depth(rendered, tmp_path):
     """The pixels of a packet lost on the wire are "no reading" for the tracker, as `capture --replay` and
     the live stream decode them (device/decode.py), not whatever filler the reassembly left there."""
-    from kinect_retarget.cli_track import load_replay
+    from kinect_retarget.cli.track_commands import load_replay
     from kinect_retarget.device.dump import DumpWriter
-    from kinect_retarget.device.emulated_stream import DEPTH_PACKETS_PER_FRAME, packets_for_frames
+    from kinect_retarget.sim.emulated_stream import DEPTH_PACKETS_PER_FRAME, packets_for_frames
     seq, _ = rendered
     packets = packets_for_frames(list(seq.raw[:3]), 3)
     lost = DEPTH_PACKETS_PER_FRAME + DEPTH_PACKETS_PER_FRAME // 2   # mid-image (the person) of frame 1

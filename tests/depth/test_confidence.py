@@ -7,8 +7,8 @@ import numpy as np
 
 from kinect_retarget.core.skeletons import INFERRED, KINECT_V1, TRACKED
 from kinect_retarget.depth.confidence import LIMB, RECOVERY_FRAMES, WARMUP_FRAMES, ConfidenceCheck
-from kinect_retarget.depth.evaluation import score
-from kinect_retarget.depth.tracker import track_depth_frames
+from kinect_retarget.sim.depth_scoring import score
+from kinect_retarget.depth.skeleton_tracker import track_depth_frames
 
 J = KINECT_V1.index
 ALL_FOUND = [(n, None) for n in ("head", "HandLeft", "HandRight", "FootLeft", "FootRight")]

@@ -9,8 +9,8 @@ from kinect_retarget.core.skeletons import NOT_TRACKED
 
 
 def test_emulated_usb_depth_to_skeleton_frames_to_rig(rendered):
-    from kinect_retarget.device.emulated import EmulatedKinect
-    from kinect_retarget.depth.producer import open_skeleton_producer
+    from kinect_retarget.sim.emulated_kinect import EmulatedKinect
+    from kinect_retarget.sources.depth_skeletons import open_skeleton_producer
     seq, _ = rendered
     producer = open_skeleton_producer(EmulatedKinect(list(seq.raw)), gravity=seq.gravity)
     frames = []
@@ -62,8 +62,8 @@ def test_emulated_usb_depth_to_skeleton_frames_to_rig(rendered):
 
 
 def test_preview_image_shows_person_and_skeleton(rendered):
-    from kinect_retarget.depth.preview import preview_rgba
-    from kinect_retarget.depth.tracker import SkeletonTracker
+    from kinect_retarget.depth.tracking_preview import preview_rgba
+    from kinect_retarget.depth.skeleton_tracker import SkeletonTracker
     seq, _ = rendered
     tr = SkeletonTracker(gravity=seq.gravity)
     pos, st = tr.update(seq.mm[0], 0.0)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from kinect_retarget.core.skeletons import KINECT_V1
-from kinect_retarget.depth.camera import DepthCamera
+from kinect_retarget.depth.depth_camera import DepthCamera
 from kinect_retarget.depth.facing import CHEST_BAND, CHEST_RADIUS, chest_facing, surface_normals
 from kinect_retarget.depth.segmentation import DepthGrid
 
@@ -15,7 +15,7 @@ UP = np.array([0.0, 1.0, 0.0])   # the renders' gravity is straight down (no til
 
 @pytest.fixture(scope="module")
 def turned(shared_data):
-    from kinect_retarget.depth.synthetic import Scenario, render_sequence
+    from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence
     return render_sequence(str(shared_data / "mocap_bvh" / "131_02.bvh"), str(shared_data / "meshes" / "makehuman"),
                            Scenario(turn_deg=60.0, seed=8), start=0, frames=2)
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from kinect_retarget.depth.geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
+from kinect_retarget.depth.surface_geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
 
 
 def _grid(h, w, spacing=0.02, z=2.0):

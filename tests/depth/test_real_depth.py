@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from kinect_retarget.core.skeletons import KINECT_V1, NOT_TRACKED
-from kinect_retarget.depth.tracker import SkeletonTracker
+from kinect_retarget.depth.skeleton_tracker import SkeletonTracker
 
 J = KINECT_V1.index
 
@@ -30,8 +30,8 @@ def test_skeltrack_frames(shared_data):
 
 
 def test_fakenect_recording(shared_data):
-    from kinect_retarget.device.calibration import Calibration
-    from kinect_retarget.device.depth_images import load_fakenect_dir
+    from kinect_retarget.device.disparity_calibration import Calibration
+    from kinect_retarget.sim.depth_sequences import load_fakenect_dir
     raws = load_fakenect_dir(shared_data / "depth_real" / "fakenect_openiss" / "fakenect-record")
     cal = Calibration()
     tr = SkeletonTracker()

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from kinect_retarget.depth.render import Room, gravity_in_camera, room_depth
+from kinect_retarget.sim.depth_render import Room, gravity_in_camera, room_depth
 from kinect_retarget.depth.segmentation import DepthGrid, connected_components, find_people, fit_floor
 
 
@@ -43,7 +43,7 @@ def test_connected_components_split_at_depth_steps():
 
 
 def test_rendered_person_is_found_among_furniture_and_a_bystander(shared_data, camera):
-    from kinect_retarget.depth.synthetic import Scenario, render_sequence
+    from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence
     seq = render_sequence(str(shared_data / "mocap_bvh" / "131_02.bvh"), str(shared_data / "meshes" / "makehuman"),
                           Scenario(second_person=(1.2, 3.5), boxes=[((-1.6, -0.9, 2.0), (-0.9, -0.1, 2.6))], seed=1),
                           frames=1)
@@ -55,7 +55,7 @@ def test_rendered_person_is_found_among_furniture_and_a_bystander(shared_data, c
     performer = min(people, key=lambda p: np.linalg.norm(p.centroid - hip))
     assert np.linalg.norm(performer.centroid[[0, 2]] - hip[[0, 2]]) < 0.2
     assert 1.3 < performer.height < 1.8
-    from kinect_retarget.depth.tracker import SkeletonTracker
+    from kinect_retarget.depth.skeleton_tracker import SkeletonTracker
     tr = SkeletonTracker(gravity=seq.gravity)
     tr.update(seq.mm[0], 0.0)
     assert tr.last_mask is not None and np.array_equal(tr.last_mask, performer.mask)

@@ -4,11 +4,11 @@ from __future__ import annotations
 import numpy as np
 
 from kinect_retarget.core.skeletons import KINECT_V1
-from kinect_retarget.depth.body_model import load_body
-from kinect_retarget.depth.bvh_motion import read_bvh_positions
-from kinect_retarget.depth.camera import raw_to_mm
+from kinect_retarget.sim.makehuman_body import load_body
+from kinect_retarget.sim.bvh_motion import read_bvh_positions
+from kinect_retarget.depth.depth_camera import raw_to_mm
 from kinect_retarget.device.depth_unpack import NO_READING_RAW
-from kinect_retarget.depth.mocap_pose import cmu_points, pose_from_points
+from kinect_retarget.sim.mocap_pose import cmu_points, pose_from_points
 
 J = KINECT_V1.index
 

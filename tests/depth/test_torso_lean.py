@@ -6,7 +6,7 @@ import numpy as np
 
 from kinect_retarget.core.skeletons import KINECT_V1
 from kinect_retarget.depth import skeleton_fit
-from kinect_retarget.depth.tracker import SkeletonTracker
+from kinect_retarget.depth.skeleton_tracker import SkeletonTracker
 
 J = KINECT_V1.index
 
@@ -26,7 +26,7 @@ def _trunk_errors(seq):
 
 
 def test_trunk_lean_is_followed(shared_data, monkeypatch):
-    from kinect_retarget.depth.synthetic import Scenario, render_sequence
+    from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence
     seq = render_sequence(str(shared_data / "mocap_bvh" / "131_03.bvh"), str(shared_data / "meshes" / "makehuman"),
                           Scenario(seed=6), start=240, frames=30)
     leaning = _trunk_errors(seq)

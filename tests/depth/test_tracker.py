@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from kinect_retarget.core.skeletons import NOT_TRACKED, TRACKED
-from kinect_retarget.depth.evaluation import score
-from kinect_retarget.depth.tracker import SkeletonTracker, track_depth_frames
+from kinect_retarget.sim.depth_scoring import score
+from kinect_retarget.depth.skeleton_tracker import SkeletonTracker, track_depth_frames
 
 
 def test_tracks_rendered_mocap_within_bound(rendered):

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pytest
 
-from kinect_retarget.device.depth_images import load_fakenect_dir
+from kinect_retarget.sim.depth_sequences import load_fakenect_dir
 
 FAKENECT = "depth_real/fakenect_openiss/fakenect-record"
 

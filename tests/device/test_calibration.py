@@ -3,7 +3,7 @@ import struct
 import numpy as np
 import pytest
 
-from kinect_retarget.device.calibration import (Calibration, calibration_from_replies, mm_to_raw,
+from kinect_retarget.device.disparity_calibration import (Calibration, calibration_from_replies, mm_to_raw,
                                                 parse_fixed_params)
 from kinect_retarget.device.errors import ProtocolError
 

@@ -26,14 +26,15 @@ def test_udev_rule(capsys):
 
 def _emulator_on_a_virtual_clock(monkeypatch, faults=None):
     """Make --simulate build an emulated Kinect whose time only it moves: what arrives is load-independent."""
-    from kinect_retarget.device import emulated
-    from kinect_retarget.device.emulated_stream import VirtualClock
+    from kinect_retarget.sim.emulated_kinect import EmulatedKinect
+    from kinect_retarget.sim.emulated_stream import VirtualClock
+    from kinect_retarget.sources import simulated_kinect
 
-    class VirtualTimeKinect(emulated.EmulatedKinect):
+    class VirtualTimeKinect(EmulatedKinect):
         def __init__(self, images, **kwargs):
             super().__init__(images, clock=VirtualClock(), faults=faults, **kwargs)
 
-    monkeypatch.setattr(emulated, "EmulatedKinect", VirtualTimeKinect)
+    monkeypatch.setattr(simulated_kinect, "EmulatedKinect", VirtualTimeKinect)
 
 
 def test_capture_simulated_with_dump_then_replay(tmp_path, shared_data, capsys, monkeypatch):
@@ -90,8 +91,8 @@ def test_bad_input_exits_2_with_a_message_not_a_traceback(tmp_path, capsys):
 
 def test_truncated_dump_keeps_its_frames_and_exits_2(tmp_path, shared_data, capsys):
     from kinect_retarget.device.dump import DumpWriter
-    from kinect_retarget.device.emulated_stream import packets_for_frames
-    from kinect_retarget.device.depth_images import load_fakenect_dir
+    from kinect_retarget.sim.emulated_stream import packets_for_frames
+    from kinect_retarget.sim.depth_sequences import load_fakenect_dir
     dump = tmp_path / "cut.dump"
     with DumpWriter(dump) as writer:
         writer.write_packets(packets_for_frames(load_fakenect_dir(shared_data / FAKENECT, limit=3), 3))
@@ -120,9 +121,9 @@ def test_python_dash_m_kinect_retarget(tmp_path, command, code, expected):
 
 
 def test_capture_gives_up_when_no_kinect_streams(tmp_path, capsys, monkeypatch):
-    from kinect_retarget import cli_device
-    from kinect_retarget.device.depth_images import synthetic_depth_frames
-    from kinect_retarget.device.emulated import EmulatedKinect
+    from kinect_retarget.cli import device_commands as cli_device
+    from kinect_retarget.sim.depth_sequences import synthetic_depth_frames
+    from kinect_retarget.sim.emulated_kinect import EmulatedKinect
 
     def unplugged_kinect(args):
         emu = EmulatedKinect(synthetic_depth_frames(2))
@@ -136,7 +137,7 @@ def test_capture_gives_up_when_no_kinect_streams(tmp_path, capsys, monkeypatch):
 
 
 def test_capture_keeps_its_frames_when_the_kinect_goes_and_stays_away(tmp_path, monkeypatch, capsys):
-    from kinect_retarget.device.emulated_stream import Faults
+    from kinect_retarget.sim.emulated_stream import Faults
     _emulator_on_a_virtual_clock(monkeypatch, Faults(unplug_at=0.21))     # after frames 0-5, for good
     out = tmp_path / "cut.npz"
     assert main(["capture", "--simulate", "--seconds", "2", "--wait", "0.3", "--out", str(out)]) == 1

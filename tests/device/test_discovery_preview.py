@@ -1,12 +1,12 @@
 import numpy as np
 import pytest
 
-from kinect_retarget.device.calibration import Calibration
+from kinect_retarget.device.disparity_calibration import Calibration
 from kinect_retarget.device.discovery import UDEV_RULES, find_kinect, list_devices
-from kinect_retarget.device.emulated import EmulatedKinect
-from kinect_retarget.device.emulated_stream import Faults
+from kinect_retarget.sim.emulated_kinect import EmulatedKinect
+from kinect_retarget.sim.emulated_stream import Faults
 from kinect_retarget.device.errors import DeviceNotFound
-from kinect_retarget.device.preview import depth_preview
+from kinect_retarget.device.depth_preview import depth_preview
 
 
 def test_list_devices_for_each_model(real_depth):

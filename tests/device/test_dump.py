@@ -5,7 +5,7 @@ import pytest
 
 from kinect_retarget.device.depth_unpack import unpack_11bit
 from kinect_retarget.device.dump import DumpWriter, read_dump, replay_dump
-from kinect_retarget.device.emulated_stream import packets_for_frames
+from kinect_retarget.sim.emulated_stream import packets_for_frames
 from kinect_retarget.device.errors import DumpError
 
 

@@ -6,9 +6,9 @@ import usb.core
 import usb.util
 
 from kinect_retarget.device import protocol as P
-from kinect_retarget.device.camera import KinectCamera
-from kinect_retarget.device.emulated import EmulatedKinect
-from kinect_retarget.device.emulated_stream import Faults
+from kinect_retarget.device.kinect_camera import KinectCamera
+from kinect_retarget.sim.emulated_kinect import EmulatedKinect
+from kinect_retarget.sim.emulated_stream import Faults
 from kinect_retarget.device.errors import DeviceGone, ProtocolError
 
 

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from kinect_retarget.device.discovery import list_devices
-from kinect_retarget.device.emulated import EmulatedKinect
-from kinect_retarget.device.emulated_stream import VirtualClock
+from kinect_retarget.sim.emulated_kinect import EmulatedKinect
+from kinect_retarget.sim.emulated_stream import VirtualClock
 from kinect_retarget.device.errors import MotorUnavailable
 from kinect_retarget.device.motor import KinectMotor, clamp_tilt, open_motor, set_tilt
 

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from kinect_retarget.device.depth_unpack import unpack_11bit
-from kinect_retarget.device.emulated_stream import packets_for_frames
+from kinect_retarget.sim.emulated_stream import packets_for_frames
 from kinect_retarget.device.protocol import DEPTH_PACKETS_PER_FRAME as PPF, DEPTH_PAYLOAD, TICKS_PER_FRAME
 from kinect_retarget.device.reassembly import FrameAssembler
 

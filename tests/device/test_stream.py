@@ -4,11 +4,11 @@ import time
 
 import numpy as np
 
-from kinect_retarget.device.emulated import EmulatedKinect
-from kinect_retarget.device.emulated_stream import Faults, VirtualClock
+from kinect_retarget.sim.emulated_kinect import EmulatedKinect
+from kinect_retarget.sim.emulated_stream import Faults, VirtualClock
 from kinect_retarget.device import protocol as P
 from kinect_retarget.device.protocol import TICKS_PER_FRAME
-from kinect_retarget.device.stream import STOPPED, STREAMING, UNPLUGGED, DepthStream
+from kinect_retarget.device.depth_stream import STOPPED, STREAMING, UNPLUGGED, DepthStream
 
 
 def _drain(stream, until, frames=None, states=None):
@@ -80,7 +80,7 @@ def _frames_before_unplug(unplug_at: float) -> int:
     """Frames of the first stream whose last packet is on the wire before `unplug_at` seconds of device time
     (the test's expectation, from the wire timing rather than from the code under test). Pick `unplug_at`
     away from a frame's end: packets reach the host a 4 ms transfer at a time."""
-    from kinect_retarget.device.emulated_stream import packet_due_time
+    from kinect_retarget.sim.emulated_stream import packet_due_time
     return sum(packet_due_time((f + 1) * P.DEPTH_PACKETS_PER_FRAME - 1) < unplug_at for f in range(100))
 
 

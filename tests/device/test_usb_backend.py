@@ -12,7 +12,7 @@ import pytest
 import usb.backend.libusb1 as L
 
 from kinect_retarget.device.depth_unpack import unpack_11bit
-from kinect_retarget.device.emulated_stream import DepthPacketizer
+from kinect_retarget.sim.emulated_stream import DepthPacketizer
 from kinect_retarget.device.errors import DeviceGone, KinectError
 from kinect_retarget.device.reassembly import FrameAssembler
 from kinect_retarget.device.usb_backend import CANCELLED, COMPLETED, NO_DEVICE, LibusbIsoPump, open_iso_pump

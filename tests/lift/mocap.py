@@ -5,7 +5,7 @@ import numpy as np
 
 from kinect_retarget.core.skeletons import KINECT_V1
 from kinect_retarget.core.take import Take
-from kinect_retarget.lift.camera import Camera, view_points
+from kinect_retarget.lift.video_camera import Camera, view_points
 from kinect_retarget.takes import bvh
 
 IMAGE = (1280, 720)
@@ -29,7 +29,7 @@ def camera() -> Camera:
 
 
 def true_signs(pos: np.ndarray, perspective: bool = True) -> np.ndarray:
-    from kinect_retarget.lift.evaluation import ray_sides
+    from kinect_retarget.sim.lift_scoring import ray_sides
     return ray_sides(pos, KINECT_V1.parent_array, camera() if perspective else None)
 
 

@@ -7,7 +7,7 @@ import pytest
 from kinect_retarget.core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED
 from kinect_retarget.lift import LiftError, LiftSettings, lift
 from kinect_retarget.lift.bones import lengths_from_take
-from kinect_retarget.lift.evaluation import (mpjpe, procrustes_align, root_relative, sign_error_rate,
+from kinect_retarget.sim.lift_scoring import (mpjpe, procrustes_align, root_relative, sign_error_rate,
                                              tracks_from_take)
 
 from .mocap import FOCAL, IMAGE, camera, rigid, seen_from, true_signs, walking_take

@@ -8,10 +8,10 @@ import pytest
 
 from kinect_retarget.core.skeletons import KINECT_V1
 from kinect_retarget.lift import LiftError, read_2d
-from kinect_retarget.lift.camera import Camera, view_points
-from kinect_retarget.lift.frames import load_frame, write_ppm
-from kinect_retarget.lift.render import background, render
-from kinect_retarget.lift.tracker import JointTracker, TrackerSettings, write_keypoints
+from kinect_retarget.lift.video_camera import Camera, view_points
+from kinect_retarget.lift.image_sequence import load_frame, write_ppm
+from kinect_retarget.sim.body_imagery import background, render
+from kinect_retarget.lift.joint_tracker import JointTracker, TrackerSettings, write_keypoints
 
 from .mocap import walking_take
 

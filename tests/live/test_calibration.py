@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from kinect_retarget.core.skeletons import KINECT_V2, NOT_TRACKED
-from kinect_retarget.live.calibration import Calibration, CalibrationError, calibrate
+from kinect_retarget.core.performer_calibration import Calibration, CalibrationError, calibrate
 from kinect_retarget.live.session import LiveSession
 from kinect_retarget.sources import TakePlayback
 

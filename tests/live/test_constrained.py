@@ -3,7 +3,7 @@ import numpy as np
 
 from kinect_retarget.core.quat import angle_between, from_matrix, to_matrix
 from kinect_retarget.core.target_rig import TargetRig, evaluate_pose
-from kinect_retarget.live.constrained import ConstrainedParentCorrection
+from kinect_retarget.core.constrained_parent import ConstrainedParentCorrection
 
 
 def chain_rig():

@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 
 from kinect_retarget.core.skeletons import KINECT_V2, NOT_TRACKED
-from kinect_retarget.live.frames import SkeletonFrame
-from kinect_retarget.live.queueing import FrameQueue
+from kinect_retarget.sources.skeleton_frame import SkeletonFrame
+from kinect_retarget.sources.frame_queue import FrameQueue
 from kinect_retarget.live.session import LiveSession
 from kinect_retarget.sources import TakePlayback
-from kinect_retarget.sources.base import FrameSource
+from kinect_retarget.sources.frame_source import FrameSource
 from kinect_retarget.takes import krtake
 
 

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from kinect_retarget.core.skeletons import INFERRED, KINECT_V1, KINECT_V2, NOT_TRACKED, TRACKED
-from kinect_retarget.live.queueing import FrameQueue
+from kinect_retarget.sources.frame_queue import FrameQueue
 from kinect_retarget.sources import OscReceiver, SourceError, TakePlayback, UsbKinectSource, open_source
-from kinect_retarget.sources.osc import FrameAssembler
+from kinect_retarget.sources.osc_receiver import FrameAssembler
 from kinect_retarget.sources.osc_codec import OscError, encode_bundle, encode_message
 
 
@@ -181,7 +181,7 @@ def test_osc_socket_error_on_the_thread_stops_with_error():
 
 # -- USB -----------------------------------------------------------------------------------------------
 def test_usb_without_tracker_refuses_with_a_sentence(monkeypatch):
-    from kinect_retarget.sources import usb
+    from kinect_retarget.sources import usb_kinect as usb
     monkeypatch.setattr(usb, "PRODUCER_MODULES", (".no_such_tracker",))
     assert "no depth-to-skeleton tracker" in usb.usb_status()
     src = UsbKinectSource(factory=None)
@@ -236,9 +236,9 @@ def test_source_rejects_nan_for_tracked_joints(rng):
 
 
 def test_usb_finds_the_depth_tracker_and_times_out_without_frames(monkeypatch):
-    from kinect_retarget.sources import usb
+    from kinect_retarget.sources import usb_kinect as usb
     factory, reason = usb.find_skeleton_producer()
-    assert factory is not None and factory.__module__.endswith("depth.producer"), reason
+    assert factory is not None and factory.__module__.endswith("sources.depth_skeletons"), reason
 
     class Silent(FakeProducer):
         class stream:

@@ -1,0 +1,561 @@
+"""The "USB Kinect" sub-panel: detected devices, stream status, tilt and LED, the simulated Kinect toggle and a
+live depth preview (the segmented person with the fitted skeleton when the tracker runs).
+
+Threads here never touch bpy: discovery, the simulated Kinect's preparation and the depth stream run on
+threads and leave plain Python results behind; `update_preview()` (a `bpy.app.timers` callback, a few times
+per second while something runs) picks them up on the main thread. Headless code calls it directly, since
+timers do not fire while a script blocks.
+"""
+from __future__ import annotations
+
+import math
+import textwrap
+import threading
+
+import bpy
+import bpy.utils.previews
+import numpy as np
+from bpy.props import BoolProperty, EnumProperty, FloatProperty
+
+from ...device import (DepthStream, KinectError, MotorUnavailable, depth_preview, list_devices,
+                      open_motor)
+from ...device.motor import LED_MODES, TILT_LIMIT_DEG
+from ...sources import SourceError, UsbKinectSource
+from ...sources.usb_kinect import find_skeleton_producer
+from . import live_controller
+
+PREVIEW_INTERVAL = 0.2          # seconds: 5 preview updates per second are plenty and cost the UI ~nothing
+PREVIEW_SCALE = 2               # 640x480 depth -> a 320x240 preview
+PREVIEW_SHAPE = (480 // PREVIEW_SCALE, 640 // PREVIEW_SCALE)
+IMAGE_NAME = "Kinect Depth Preview"
+SIM_FRAMES = 90                 # three seconds of rendered motion, looped by the emulated Kinect
+THREAD_JOIN_S = 1.0             # how long unregister waits for a helper thread
+
+LED_ITEMS = [(m, m.replace("-", " ").title(), f"Kinect LED: {m}") for m in
+             ("green", "red", "yellow", "blink-green", "blink-red-yellow", "off")]
+assert all(m[0] in LED_MODES for m in LED_ITEMS)
+
+
+# -- runtime state (never saved in the .blend) ------------------------------------------------------------------
+class _Runtime:
+    def __init__(self):
+        self.devices: list[dict] | None = None      # None: not looked yet
+        self.discovery_error = ""
+        self.discovery: threading.Thread | None = None
+        self.discovery_result: tuple[list[dict], str] | None = None
+        self.stream: DepthStream | None = None      # the panel's own preview stream (not live's)
+        self.sim_backend = None                     # the emulated Kinect (sim/), once prepared
+        self.sim_label = ""
+        self.sim_error = ""
+        self.sim_thread: threading.Thread | None = None
+        self.previews = None                        # bpy.utils.previews collection
+        self.preview_kind = ""                      # "skeleton", "depth" or ""
+        self.preview_frame = None                   # identity of the frame last shown
+
+
+_rt = _Runtime()
+_sim_lock = threading.Lock()   # discovery (a thread) and the main thread may both ask for the simulated Kinect
+
+
+def _device_summary(info) -> dict:
+    return {"model": info.model, "serial": info.serial, "camera_available": info.camera_available,
+            "motor_available": info.motor_available, "motor_note": info.motor_note, "problem": info.problem}
+
+
+# -- the simulated Kinect ---------------------------------------------------------------------------------------
+def simulated_images() -> tuple[list[np.ndarray], str]:
+    """Raw depth frames for the emulated Kinect (rendered real motion, else the synthetic figure)."""
+    from ...sources.simulated_kinect import simulated_images as images
+    return images(SIM_FRAMES)
+
+
+def _prepare_simulated() -> None:
+    try:
+        images, label = simulated_images()
+        from ...sources.simulated_kinect import emulated_kinect
+        _rt.sim_backend, _rt.sim_label = emulated_kinect(images), label
+    except Exception as exc:  # a thread must leave a sentence, not a traceback
+        _rt.sim_error = f"the simulated Kinect could not be prepared ({type(exc).__name__}: {exc})"
+
+
+def simulated_backend(wait: float | None = 0.0):
+    """The emulated Kinect (one per session, so its motor keeps its angle). Preparing it renders depth the
+    first time, so that runs on a thread: None while it is not ready after `wait` seconds."""
+    with _sim_lock:
+        thread = _rt.sim_thread
+        if _rt.sim_backend is None and thread is None:
+            _rt.sim_error = ""
+            thread = _rt.sim_thread = threading.Thread(target=_prepare_simulated, name="kinect_retarget-simulate",
+                                                       daemon=True)
+            thread.start()
+    if _rt.sim_backend is None and thread is not None:
+        thread.join(wait)
+        with _sim_lock:
+            if not thread.is_alive() and _rt.sim_thread is thread:
+                _rt.sim_thread = None   # done (or failed: the next call tries again)
+    return _rt.sim_backend
+
+
+def _preparing_simulated() -> bool:
+    return _rt.sim_thread is not None and _rt.sim_thread.is_alive()
+
+
+def _settings(context=None):
+    context = context or bpy.context
+    return getattr(context.scene, "kinect_retarget_usb", None)
+
+
+def _simulate(context=None) -> bool:
+    s = _settings(context)
+    return bool(s and s.simulate)
+
+
+def _backend(context=None):
+    """The pyusb backend to use: the emulated Kinect when simulating (SourceError while it is being prepared),
+    None for real USB (pyusb's libusb1 backend)."""
+    return _simulated_or_error() if _simulate(context) else None
+
+
+def _simulated_or_error():
+    backend = simulated_backend()
+    if backend is None:
+        ensure_timer()   # the panel redraws when the preparation ends
+        raise SourceError(_rt.sim_error or "the simulated Kinect is being prepared (rendering depth the first "
+                                           "time takes about a minute); try again in a moment")
+    return backend
+
+
+# -- discovery on a thread --------------------------------------------------------------------------------------
+def _discover(simulate: bool) -> None:
+    try:
+        backend = None
+        if simulate:
+            backend = simulated_backend(wait=None)
+            if backend is None:
+                raise KinectError(_rt.sim_error)
+        _rt.discovery_result = ([_device_summary(k) for k in list_devices(backend)], "")
+    except KinectError as exc:
+        _rt.discovery_result = ([], str(exc))
+    except Exception as exc:  # e.g. a USB stack error we did not foresee: say it, keep the UI alive
+        _rt.discovery_result = ([], f"looking for Kinects failed ({type(exc).__name__}: {exc})")
+
+
+def refresh_devices(context=None) -> bool:
+    """Look for Kinects on a thread; the preview timer picks up the answer. False if a search is running."""
+    if discovering():
+        return False
+    _rt.discovery_result = None
+    _rt.discovery = threading.Thread(target=_discover, args=(_simulate(context),),
+                                     name="kinect_retarget-discovery", daemon=True)
+    _rt.discovery.start()
+    ensure_timer()
+    return True
+
+
+def discovering() -> bool:
+    return _rt.discovery is not None and _rt.discovery.is_alive()
+
+
+def wait_for_discovery(timeout: float = 10.0) -> bool:
+    """For scripts and tests: wait for a search to end and take its answer (True if there is one)."""
+    if _rt.discovery is not None:
+        _rt.discovery.join(timeout)
+    return _collect_discovery()
+
+
+def _collect_discovery() -> bool:
+    if discovering() or _rt.discovery_result is None:
+        return False
+    _rt.devices, _rt.discovery_error = _rt.discovery_result
+    _rt.discovery_result, _rt.discovery = None, None
+    return True
+
+
+def devices() -> list[dict] | None:
+    return _rt.devices
+
+
+# -- the panel's own depth stream -----------------------------------------------------------------------------
+def _live_producer():
+    """The live session's skeleton producer when live runs on the USB Kinect, else None."""
+    c = live_controller.controller()
+    src = c.session.source if c is not None else None
+    return src.producer if isinstance(src, UsbKinectSource) else None
+
+
+def live_uses_usb() -> bool:
+    c = live_controller.controller()
+    return c is not None and isinstance(c.session.source, UsbKinectSource)
+
+
+def start_stream(context=None) -> DepthStream:
+    """Stream depth for the preview without tracking (live opens its own stream)."""
+    if live_uses_usb():
+        raise SourceError("live is using the Kinect; its preview is shown already")
+    if _rt.stream is None or not _rt.stream.running:
+        _rt.stream = DepthStream(_backend(context), queue_size=2).start()
+    ensure_timer()
+    return _rt.stream
+
+
+def stop_stream() -> bool:
+    """Stop the panel's stream (True when its thread ended). Its last status stays on show."""
+    stream = _rt.stream
+    return stream.stop() if stream is not None else True
+
+
+def stream_running() -> bool:
+    return _rt.stream is not None and _rt.stream.running
+
+
+def stream_status():
+    """StreamStatus of the stream on show: live's when live runs on the Kinect, else the panel's."""
+    producer = _live_producer()
+    stream = getattr(producer, "stream", None) if producer is not None else _rt.stream
+    return getattr(stream, "status", None)
+
+
+# -- the preview image --------------------------------------------------------------------------------------
+def _grey_rgba(mm: np.ndarray) -> np.ndarray:
+    grey = depth_preview(mm, PREVIEW_SHAPE).astype(np.float32)[::-1] / 255.0   # Blender rows are bottom-up
+    rgba = np.empty(grey.shape + (4,), np.float32)
+    rgba[..., :3] = grey[..., None]
+    rgba[..., 3] = 1.0
+    return rgba
+
+
+def _next_rgba():
+    """(rgba, kind, frame identity) of the newest frame not shown yet, or None."""
+    producer = _live_producer()
+    if producer is not None:
+        preview = getattr(producer, "preview", None)
+        p = preview() if callable(preview) else None
+        if p is None or (_rt.preview_kind == "skeleton" and p is _rt.preview_frame):
+            return None
+        from ...depth.tracking_preview import preview_rgba
+        camera = getattr(getattr(producer, "tracker", None), "camera", None)
+        return preview_rgba(*p, camera=camera, scale=PREVIEW_SCALE), "skeleton", p
+    frame = _rt.stream.latest_frame() if _rt.stream is not None else None
+    if frame is None or frame.mm is None:
+        return None
+    return _grey_rgba(frame.mm), "depth", frame.index
+
+
+def preview_image():
+    return bpy.data.images.get(IMAGE_NAME)
+
+
+def _upload(rgba: np.ndarray) -> None:
+    h, w = rgba.shape[:2]
+    flat = np.ascontiguousarray(rgba, dtype=np.float32).ravel()
+    img = preview_image()
+    if img is None or tuple(img.size) != (w, h):
+        if img is not None:
+            bpy.data.images.remove(img)
+        img = bpy.data.images.new(IMAGE_NAME, w, h, alpha=True)
+    img.pixels.foreach_set(flat)
+    img.update()
+    if _rt.previews is not None:   # the sidebar shows it through a custom preview (template_icon)
+        icon = _rt.previews.get("depth") or _rt.previews.new("depth")
+        if tuple(icon.image_size) != (w, h):
+            icon.image_size = (w, h)   # reallocates: only when the size changes
+        icon.image_pixels_float.foreach_set(flat)   # drawn from these pixels on the next redraw
+
+
+def update_preview() -> float | None:
+    """The timer: take discovery results, free the device for live, show the newest depth frame.
+    Returns the next interval, or None (timer ends) when nothing is running."""
+    try:
+        changed = _collect_discovery()
+        if live_uses_usb() and stream_running():
+            stop_stream()   # live has its own stream; one Kinect cannot be opened twice
+        nxt = _next_rgba()
+        if nxt is not None:
+            rgba, _rt.preview_kind, _rt.preview_frame = nxt
+            _upload(rgba)
+            changed = True
+        if changed:
+            live_controller.redraw_3d_views()
+    except Exception as exc:  # a timer that raises is dropped silently by Blender: say it, and go on
+        print(f"kinect_retarget: depth preview: {type(exc).__name__}: {exc}")
+    busy = discovering() or _preparing_simulated() or stream_running() or live_uses_usb()
+    return PREVIEW_INTERVAL if busy else None
+
+
+def ensure_timer() -> None:
+    if not bpy.app.timers.is_registered(update_preview):
+        # persistent: a stream outlives a file load, so must the timer that shows it (the image is recreated)
+        bpy.app.timers.register(update_preview, first_interval=0.0, persistent=True)
+
+
+# -- live on the USB Kinect ------------------------------------------------------------------------------------
+def _make_usb_source(settings, prefs):
+    """The USB source for live (live_controller.usb_source_factory): the simulated Kinect when chosen, and the device
+    freed from the panel's own preview stream first."""
+    stop_stream()
+    usb = getattr(settings.id_data, "kinect_retarget_usb", None)
+    if usb is not None and usb.simulate:
+        backend = _simulated_or_error()
+        factory, reason = find_skeleton_producer()
+        if factory is None:
+            raise SourceError(f"USB Kinect: {reason}")
+        source, label = UsbKinectSource(factory=lambda: factory(source=backend)), "simulated USB Kinect"
+    else:
+        source, label = UsbKinectSource(), "USB Kinect"
+    ensure_timer()
+    return source, label
+
+
+# -- properties -------------------------------------------------------------------------------------------------
+def _simulate_changed(self, context) -> None:
+    stop_stream()
+    _rt.devices, _rt.discovery_error = None, ""   # the list described the other kind of device
+    refresh_devices(context)
+
+
+class KinectRetargetUsbSettings(bpy.types.PropertyGroup):
+    simulate: BoolProperty(
+        name="Simulated Kinect", default=False, update=_simulate_changed,
+        description="Use an emulated Kinect streaming rendered depth of a real motion, for trying the whole "
+                    "chain (devices, tilt, preview, live) without the hardware")
+    tilt: FloatProperty(name="Tilt", subtype="ANGLE", default=0.0, min=-math.radians(TILT_LIMIT_DEG),
+                        max=math.radians(TILT_LIMIT_DEG),
+                        description="Motor angle from the horizon (the Kinect's limit is ±27°)")
+    led: EnumProperty(name="LED", items=LED_ITEMS, default="green", description="Colour of the Kinect's LED")
+    show_preview: BoolProperty(name="Depth Preview", default=True, description="Show the depth preview image")
+
+
+# -- operators --------------------------------------------------------------------------------------------------
+class KINECT_RETARGET_OT_usb_refresh(bpy.types.Operator):
+    """Look for Kinects on USB (in the background; the list updates when the search ends)"""
+    bl_idname = "kinect_retarget.usb_refresh"
+    bl_label = "Refresh Devices"
+    bl_options = {"REGISTER"}
+
+    def execute(self, context):
+        if not refresh_devices(context):
+            self.report({"INFO"}, "Already looking for Kinects")
+        return {"FINISHED"}
+
+
+def _motor_call(op, context, action, describe):
+    try:
+        motor = open_motor(_backend(context))
+        try:
+            result = action(motor)
+        finally:
+            motor.close()
+    except MotorUnavailable as exc:
+        op.report({"ERROR"}, f"The motor is not available: {exc}")
+        return {"CANCELLED"}
+    except (KinectError, SourceError, ValueError) as exc:
+        op.report({"ERROR"}, str(exc))
+        return {"CANCELLED"}
+    op.report({"INFO"}, describe(result))
+    return {"FINISHED"}
+
+
+class KINECT_RETARGET_OT_usb_tilt(bpy.types.Operator):
+    """Tilt the Kinect's motor (-27° to +27° from the horizon)"""
+    bl_idname = "kinect_retarget.usb_tilt"
+    bl_label = "Set Tilt"
+    bl_options = {"REGISTER"}
+
+    angle: FloatProperty(name="Angle", subtype="ANGLE", min=-math.radians(TILT_LIMIT_DEG),
+                         max=math.radians(TILT_LIMIT_DEG), description="Tilt (default: the panel's value)")
+
+    def execute(self, context):
+        s = _settings(context)
+        angle = self.angle if self.properties.is_property_set("angle") or s is None else s.tilt
+        return _motor_call(self, context, lambda m: m.set_tilt(math.degrees(angle)),
+                           lambda sent: f"Tilting the Kinect to {sent:+.1f}°")
+
+
+class KINECT_RETARGET_OT_usb_led(bpy.types.Operator):
+    """Set the Kinect's LED"""
+    bl_idname = "kinect_retarget.usb_led"
+    bl_label = "Set LED"
+    bl_options = {"REGISTER"}
+
+    mode: EnumProperty(name="Mode", items=LED_ITEMS, default="green")
+
+    def execute(self, context):
+        s = _settings(context)
+        mode = self.mode if self.properties.is_property_set("mode") or s is None else s.led
+        return _motor_call(self, context, lambda m: m.set_led(mode), lambda _: f"Kinect LED: {mode}")
+
+
+class KINECT_RETARGET_OT_usb_preview(bpy.types.Operator):
+    """Start or stop streaming depth for the preview image (live shows its own, with the skeleton)"""
+    bl_idname = "kinect_retarget.usb_preview"
+    bl_label = "Depth Preview"
+    bl_options = {"REGISTER"}
+
+    @classmethod
+    def poll(cls, context):
+        if live_uses_usb():
+            cls.poll_message_set("Live is using the Kinect; the preview shows its frames")
+            return False
+        return True
+
+    def execute(self, context):
+        if stream_running():
+            stop_stream()
+            return {"FINISHED"}
+        try:
+            start_stream(context)
+        except SourceError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+
+# -- the panel --------------------------------------------------------------------------------------------------
+_STATE_ICONS = {"streaming": "REC", "connecting": "TIME", "waiting for device": "TIME", "unplugged": "UNLINKED",
+                "error": "ERROR", "stopped": "PAUSE"}
+
+
+def _wrapped(layout, text: str, icon: str = "NONE", width_px: int = 280, alert: bool = False) -> None:
+    """Labels do not wrap: split long sentences (device problems, fixes) to the sidebar's width."""
+    col = layout.column(align=True)
+    col.alert = alert
+    chars = max(20, int(width_px / 6.5))
+    for n, line in enumerate(textwrap.wrap(text, chars) or [""]):
+        col.label(text=line, icon=icon if n == 0 else "BLANK1")
+
+
+class KINECT_RETARGET_PT_usb(bpy.types.Panel):
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "Kinect"
+    bl_label = "USB Kinect"
+    bl_parent_id = "KINECT_RETARGET_PT_main"
+
+    @classmethod
+    def poll(cls, context):
+        s = getattr(context.scene, "kinect_retarget", None)
+        return s is not None and s.source == "USB" and _settings(context) is not None
+
+    def draw(self, context):
+        layout = self.layout
+        u = _settings(context)
+        region = getattr(context, "region", None)
+        width = getattr(region, "width", 280) or 280
+        self._draw_devices(layout, u, width)
+        self._draw_stream(layout, u, width)
+        self._draw_motor(layout, u, width)
+        if u.show_preview:
+            self._draw_preview(layout)
+
+    @staticmethod
+    def _draw_devices(layout, u, width):
+        st = stream_status()
+        streaming = st.device if st is not None and st.state == "streaming" else ""
+        box = layout.box()
+        row = box.row(align=True)
+        row.label(text="Devices", icon="OUTLINER_OB_CAMERA")
+        row.prop(u, "simulate", text="Simulated", toggle=True)
+        row.operator("kinect_retarget.usb_refresh", text="", icon="FILE_REFRESH")
+        if _preparing_simulated():
+            _wrapped(box, "Preparing the simulated Kinect (rendering depth of a real motion; the first time "
+                          "takes about a minute)…", "TIME", width)
+        elif discovering():
+            box.label(text="Looking for Kinects…", icon="TIME")
+        if _rt.sim_error and u.simulate:
+            _wrapped(box, _rt.sim_error, "ERROR", width, alert=True)
+        if _rt.discovery_error:
+            _wrapped(box, _rt.discovery_error, "ERROR", width, alert=True)
+        elif _rt.devices is None:
+            if not discovering():
+                box.label(text="Press Refresh to look for Kinects", icon="INFO")
+        elif not _rt.devices:
+            _wrapped(box, "No Kinect found: plug it in and connect its 12 V power adapter, then Refresh",
+                     "INFO", width)
+        for d in _rt.devices or ():
+            col = box.column(align=True)
+            col.label(text=f"{d['model']}  {d['serial']}", icon="CHECKMARK" if d["camera_available"] else "ERROR")
+            in_use = bool(streaming) and streaming.endswith(d["serial"])   # a busy camera may refuse a 2nd open
+            camera = "streaming" if in_use else "ready" if d["camera_available"] else "cannot be opened"
+            col.label(text=f"Camera: {camera}", icon="BLANK1")
+            col.label(text="Motor: " + ("ready" if d["motor_available"] else "not available"), icon="BLANK1")
+            if d["problem"] and not in_use:
+                _wrapped(col, d["problem"], "ERROR", width, alert=True)
+        if u.simulate and _rt.sim_label:
+            box.label(text=f"Simulated: {_rt.sim_label}", icon="INFO")
+
+    @staticmethod
+    def _draw_stream(layout, u, width):
+        box = layout.box()
+        st = stream_status()
+        row = box.row(align=True)
+        using_live = live_uses_usb()
+        row.label(text="Stream" + (" (live)" if using_live else ""), icon="PLAY" if st and st.fps else "PAUSE")
+        running = stream_running()
+        row.prop(u, "show_preview", text="", icon="IMAGE_DATA")
+        sub = row.row(align=True)
+        sub.operator("kinect_retarget.usb_preview", text="Stop" if running else "Stream Depth",
+                     icon="PAUSE" if running else "PLAY", depress=running)
+        if st is None:
+            box.label(text="Not streaming", icon="BLANK1")
+            return
+        message = st.message[:1].upper() + st.message[1:] if st.message else st.state.capitalize()
+        _wrapped(box, message, _STATE_ICONS.get(st.state, "INFO"), width, alert=st.state in ("error", "unplugged"))
+        col = box.column(align=True)
+        col.label(text=f"{st.fps:.1f} frames/s · {st.frames} frames")
+        col.label(text=f"dropped {st.frames_dropped} · reconnects {st.reconnects}"
+                       + (f" · late {st.queue_overflows}" if st.queue_overflows else ""))
+
+    @staticmethod
+    def _draw_motor(layout, u, width):
+        box = layout.box()
+        motor = next((d for d in _rt.devices or () if not d["motor_available"] and d["motor_note"]), None)
+        row = box.row(align=True)
+        row.prop(u, "tilt")
+        row.operator("kinect_retarget.usb_tilt", text="", icon="CON_ROTLIKE")
+        row = box.row(align=True)
+        row.prop(u, "led", text="LED")
+        row.operator("kinect_retarget.usb_led", text="", icon="LIGHT")
+        if motor is not None:
+            _wrapped(box, f"Motor: {motor['motor_note']}", "INFO", width)
+
+    @staticmethod
+    def _draw_preview(layout):
+        icon = _rt.previews.get("depth") if _rt.previews is not None else None
+        if icon is None or preview_image() is None:
+            layout.label(text="Depth preview appears while streaming or live", icon="IMAGE_DATA")
+            return
+        caption = "Person and fitted skeleton" if _rt.preview_kind == "skeleton" else "Depth (near = bright)"
+        layout.label(text=caption, icon="IMAGE_DATA")
+        layout.template_icon(icon_value=icon.icon_id, scale=9.0)
+
+
+# -- registration ---------------------------------------------------------------------------------------------
+def register_extra() -> None:
+    bpy.types.Scene.kinect_retarget_usb = bpy.props.PointerProperty(type=KinectRetargetUsbSettings)
+    _rt.previews = bpy.utils.previews.new()
+    live_controller.usb_source_factory = _make_usb_source
+
+
+def unregister_extra() -> None:
+    """Undo everything: the timer, the panel's stream, helper threads, the preview, the live hook."""
+    if bpy.app.timers.is_registered(update_preview):
+        bpy.app.timers.unregister(update_preview)
+    stop_stream()
+    _rt.stream = None
+    for thread in (_rt.discovery, _rt.sim_thread):
+        if thread is not None:
+            thread.join(THREAD_JOIN_S)   # short ones; a first render cannot be interrupted (it touches no bpy)
+    _rt.discovery = _rt.sim_thread = _rt.discovery_result = None
+    live_controller.usb_source_factory = None
+    if _rt.previews is not None:
+        bpy.utils.previews.remove(_rt.previews)
+        _rt.previews = None
+    img = preview_image()
+    if img is not None:
+        bpy.data.images.remove(img)
+    _rt.preview_kind, _rt.preview_frame = "", None
+    del bpy.types.Scene.kinect_retarget_usb
+
+
+CLASSES = (KinectRetargetUsbSettings, KINECT_RETARGET_OT_usb_refresh, KINECT_RETARGET_OT_usb_tilt,
+           KINECT_RETARGET_OT_usb_led, KINECT_RETARGET_OT_usb_preview, KINECT_RETARGET_PT_usb)

@@ -1,0 +1,77 @@
+"""Bake Take operator: gathers settings, calls bake_take() with report=self.report (the io_anim_bvh way)."""
+from __future__ import annotations
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
+from bpy_extras.io_utils import ImportHelper
+
+from ...core.pipeline import RetargetSettings
+from ...core.presets import load_mapping_file
+from ...core.take import TakeError
+from ...takes import load_take
+from ..bake_take import bake_take, take_display_name
+from .mapping_table import table_overrides
+from .preferences import FILTER_ITEMS
+from .properties import PRESET_ITEMS, ROOT_ITEMS, target_armature
+
+
+class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper):
+    """Bake a recorded take (Kinect CSV/JSON, NTU, MSRC-12, UTKinect, BVH, .krtake) onto the target armature"""
+
+    bl_idname = "kinect_retarget.bake_take"
+    bl_label = "Bake Take"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filter_glob: StringProperty(default="*.krtake;*.csv;*.json;*.skeleton;*.txt;*.bvh", options={"HIDDEN"})
+    preset: EnumProperty(name="Preset", items=PRESET_ITEMS, default="auto")
+    mapping_file: StringProperty(name="Mapping JSON", subtype="FILE_PATH", default="")
+    filter: EnumProperty(name="Filter", items=FILTER_ITEMS, default="default")
+    root: EnumProperty(name="Root Motion", items=ROOT_ITEMS, default="xyz")
+    fps: FloatProperty(name="FPS", description="Scene rate (0: the take's rate)", default=0.0, min=0.0)
+    frame_start: IntProperty(name="Start Frame", default=1)
+    mirror: BoolProperty(name="Mirror", description="Swap the performer's left and right", default=False)
+
+    @classmethod
+    def poll(cls, context):
+        if target_armature(context) is None:
+            cls.poll_message_set("Select an armature to bake onto")
+            return False
+        return True
+
+    def invoke(self, context, event):
+        # start from the sidebar's choices; the file browser shows them for this bake
+        s = getattr(context.scene, "kinect_retarget", None)
+        if s is not None:
+            self.preset, self.filter, self.root, self.mirror = s.preset, s.filter, s.root, s.mirror
+        return super().invoke(context, event)
+
+    def execute(self, context):
+        obj = target_armature(context)
+        wm = context.window_manager
+        try:
+            take = load_take(self.filepath)
+            take.metadata.setdefault("name", take_display_name(self.filepath))
+            # the sidebar's mapping table, then a mapping file on top
+            s = getattr(context.scene, "kinect_retarget", None)
+            table = (table_overrides(s) or {}) if s is not None else {}
+            overrides = {b: j for b, j in table.items() if b in obj.pose.bones}  # rows for this rig only
+            if self.mapping_file:
+                overrides.update(load_mapping_file(bpy.path.abspath(self.mapping_file)))
+            settings = RetargetSettings(filter=self.filter, root_mode=self.root, fps=self.fps or None,
+                                        frame_start=self.frame_start, mirror=self.mirror)
+        except (TakeError, ValueError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        wm.progress_begin(0, 100)
+        try:
+            bake_take(obj, take, preset=self.preset, overrides=overrides or None, settings=settings,
+                      report=self.report, progress=lambda x: wm.progress_update(int(100 * x)))
+        except (TakeError, ValueError) as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        finally:
+            wm.progress_end()
+        return {"FINISHED"}
+
+
+CLASSES = (KINECT_RETARGET_OT_bake_take,)

@@ -1,0 +1,164 @@
+"""SkeletonTracker: Kinect v1 depth frames in, Kinect v1 skeleton frames out (the SDK's job, in numpy).
+
+    tracker = SkeletonTracker()
+    positions, states = tracker.update(depth_mm, timestamp_seconds)   # (20, 3) metres, (20,) 0/1/2
+
+Safe for any input: a frame of the wrong size or type, all zeros or all "no reading" gives every joint
+NOT_TRACKED (and `tracker.status` says why), never an exception or NaN. Runs on the caller's thread (a
+device thread may call it; it never touches bpy).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.skeletons import KINECT_V1
+from ..core.take import Take
+from .body_model_fit import BodyCalibration
+from .depth_camera import DepthCamera
+from .confidence import ConfidenceCheck
+from .segmentation import DepthGrid, FloorPlane, PersonMask, find_people, fit_floor
+from .skeleton_fit import FitResult, fit_person
+
+LOST_RESET_S = 0.5   # forget the previous pose after this long without the person (then re-acquire)
+CALIBRATION_FRAMES = 15
+
+
+@dataclass
+class TrackerSettings:
+    step: int = 4                 # grid stride on the 640x480 image
+    smoothing: float = 0.35       # 0 = raw fit; blends toward the previous frame for small moves only
+    floor_refit_every: int = 15   # frames between floor fits (the floor does not move)
+
+
+class SkeletonTracker:
+    def __init__(self, camera: DepthCamera | None = None, gravity=None, settings: TrackerSettings | None = None):
+        self.camera = camera or DepthCamera()
+        self.gravity: np.ndarray | None = None
+        self.settings = settings or TrackerSettings()
+        self.skeleton = KINECT_V1
+        self.reset()
+        if gravity is not None:
+            self.set_gravity(gravity)   # any scale (an accelerometer reads about 9.8): kept as a unit vector
+
+    def reset(self) -> None:
+        self.floor: FloorPlane | None = None
+        self.calibration = BodyCalibration()
+        self.confidence = ConfidenceCheck()
+        self.status = "waiting for a person"
+        self.frames = 0
+        self._prev: np.ndarray | None = None
+        self._prev_states: np.ndarray | None = None
+        self._lateral: np.ndarray | None = None
+        self._person_centroid: np.ndarray | None = None
+        self._last_seen: float | None = None
+        self.last_grid: DepthGrid | None = None
+        self.last_mask: np.ndarray | None = None
+        self.last_good: FitResult | None = None
+
+    def set_gravity(self, gravity) -> None:
+        """Accelerometer reading (any scale), pointing down in camera space."""
+        g = np.asarray(gravity, dtype=np.float64)
+        if g.shape == (3,) and np.all(np.isfinite(g)) and np.linalg.norm(g) > 1e-6:
+            self.gravity = g / np.linalg.norm(g)
+            self.floor = None
+
+    def _none(self, why: str):
+        self.status = why
+        return np.zeros((20, 3)), np.zeros(20, np.uint8)
+
+    def update(self, depth_mm: np.ndarray, timestamp: float):
+        """One depth frame (480, 640) uint16 millimetres (0 = no reading) -> (positions, states)."""
+        self.frames += 1
+        d = np.asarray(depth_mm)
+        if d.shape != (self.camera.height, self.camera.width):
+            return self._none(f"depth frame has shape {d.shape}, expected "
+                              f"({self.camera.height}, {self.camera.width})")
+        if d.dtype.kind not in "ui":
+            d = np.nan_to_num(d.astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0).clip(0, 65535)
+        try:
+            ts = float(timestamp)
+        except (TypeError, ValueError):
+            ts = float("nan")
+        grid = DepthGrid.from_mm(d, self.camera, self.settings.step)
+        self.last_grid, self.last_mask = grid, None
+        if grid.valid.sum() < 100:
+            self._lose(ts)
+            return self._none("no depth readings in this frame")
+        up = -(self.gravity if self.gravity is not None else np.array([0.0, -1.0, 0.0]))
+        if self.floor is None or self.frames % self.settings.floor_refit_every == 0:
+            self.floor = fit_floor(grid, self.gravity, self.floor)
+        if self.floor is not None:
+            up = self.floor.normal
+        people = find_people(grid, self.floor, -up)
+        person = self._choose(people, ts)
+        if person is None:
+            self._lose(ts)
+            return self._none("no person in view")
+        last = self.last_good
+        fit = fit_person(grid, person.mask, up, self.calibration, self._prev, self._prev_states, self._lateral,
+                         None if last is None else last.torso_centre, self.confidence.predict(),
+                         self.confidence.settled, self.confidence.facing_steady)
+        if fit is None or not np.all(np.isfinite(fit.positions)):
+            self._lose(ts)
+            return self._none("person found but no skeleton fitted")
+        pos, st = fit.positions, self.confidence.assess(fit.positions, fit.states, fit)
+        self._calibrate(person, fit, up)
+        if self._prev is not None and self.settings.smoothing > 0:
+            step = np.linalg.norm(pos - self._prev, axis=1, keepdims=True)
+            w = self.settings.smoothing * np.clip(1.0 - step / 0.08, 0.0, 1.0)  # fast moves are not lagged
+            pos = pos + w * (self._prev - pos)
+        self.confidence.remember(pos)
+        self._prev, self._prev_states, self._lateral = pos.copy(), fit.states.copy(), fit.lateral
+        self._person_centroid, self._last_seen = person.centroid, ts
+        self.last_mask, self.last_good = person.mask, fit
+        self.status = "tracking" if self.calibration.frames else "tracking (calibrating)"
+        return pos, st
+
+    def _lose(self, ts: float) -> None:
+        if self._last_seen is None or not np.isfinite(ts) or ts - self._last_seen > LOST_RESET_S:
+            self._prev = self._prev_states = self._lateral = self._person_centroid = self.last_good = None
+            self.confidence.reset()
+
+    def _choose(self, people: list[PersonMask], ts: float) -> PersonMask | None:
+        """The tracked person by continuity; a new one is the largest person-like, most central region."""
+        if not people:
+            return None
+        if self._person_centroid is not None:
+            near = min(people, key=lambda p: np.linalg.norm(p.centroid - self._person_centroid))
+            if np.linalg.norm(near.centroid - self._person_centroid) < 0.6:
+                return near
+        tall = [p for p in people if p.height > 1.1] or people
+        return max(tall, key=lambda p: p.pixels / (1.0 + abs(p.centroid[0]) / max(p.centroid[2], 0.5)))
+
+    def _calibrate(self, person: PersonMask, fit: FitResult, up: np.ndarray) -> None:
+        """Measure standing height on the first frames where the head and both feet are seen."""
+        if self.calibration.frames >= CALIBRATION_FRAMES or self.floor is None:
+            return
+        labels = {k: p for k, p in fit.extrema}
+        if not {"head", "FootLeft", "FootRight"} <= set(labels):
+            return
+        feet_h = [self.floor.height(labels[k]) for k in ("FootLeft", "FootRight")]
+        pts = self.last_grid.xyz[person.mask]
+        near_head = pts[np.linalg.norm(pts - labels["head"], axis=1) < 0.2]
+        top = float(np.max(self.floor.height(near_head))) if len(near_head) else self.floor.height(labels["head"])
+        if max(feet_h) > 0.15 or not 1.2 < top < 2.2:  # not standing on the floor
+            return
+        self.calibration.update(top, float(self.floor.height(fit.torso_centre)))
+
+
+def track_depth_frames(depth_mm: np.ndarray, times: np.ndarray, camera: DepthCamera | None = None,
+                       gravity=None, settings: TrackerSettings | None = None, progress=None) -> Take:
+    """Run the tracker over a capture: (F, 480, 640) millimetres and (F,) seconds -> a Kinect v1 Take."""
+    tracker = SkeletonTracker(camera, gravity, settings)
+    n = len(depth_mm)
+    pos = np.zeros((n, 20, 3))
+    st = np.zeros((n, 20), np.uint8)
+    for i in range(n):
+        pos[i], st[i] = tracker.update(depth_mm[i], times[i])
+        if progress is not None:
+            progress(i + 1, n)
+    rate = 30.0 if n < 2 else float(np.clip(round(1.0 / np.median(np.diff(times)), 3), 1, 240))
+    return Take(KINECT_V1, pos, st, np.asarray(times, dtype=np.float64), rate, "depth",
+                {"tracker": "kinect_retarget.depth", "calibrated_height_m": round(tracker.calibration.height, 3)})

@@ -1,0 +1,350 @@
+"""An emulated Kinect v1, as a pyusb backend (usb.backend.IBackend).
+
+It enumerates the camera (and, for the 1414, the motor; for the 1473 and Kinect for Windows, the audio
+chip) with real descriptors (emulated_usb.py), answers the GM/RB command protocol with register state, stalls on
+malformed commands as the device's control pipe would, drives a tilt motor with an accelerometer (emulated_motor.py), and
+streams depth built from a sequence of depth images through the iso seam (emulated_stream.py), with fault
+injection. The driver runs unchanged against it: only the iso seam has an emulated implementation.
+"""
+from __future__ import annotations
+
+import array
+import errno
+import itertools
+import struct
+import threading
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import usb.backend
+from usb.core import USBError
+
+from ..device import protocol as P
+from ..device.depth_unpack import pack_11bit
+from .emulated_motor import EmulatedMotor, Rejected
+from .emulated_stream import DepthPacketizer, EmulatedIsoPump, Faults, VirtualClock
+from .emulated_usb import UsbFunction, build_functions
+from ..device.protocol import TICKS_PER_FRAME
+from ..device.usb_backend import LIBUSB_ERROR_NO_DEVICE
+
+LIBUSB_ERROR_PIPE = -9
+LIBUSB_ERROR_ACCESS = -3
+LIBUSB_ERROR_TIMEOUT = -7
+DEFAULT_SERIAL = "A00366A08793039A"
+CONST_SHIFT = 200
+FIXED_PARAMS = (7.5, 2.4, 120.0, 0.1052)       # emitter dist (cm), rcmos dist (cm), ref dist (mm), pixel (mm)
+
+
+@dataclass
+class _Handle:
+    function: UsbFunction
+    generation: int
+    claimed: set = field(default_factory=set)
+    alt: dict = field(default_factory=dict)
+
+
+@dataclass
+class _DepthStreamState:
+    id: int
+    start_time: float
+    packetizer: DepthPacketizer
+
+
+class EmulatedKinect(usb.backend.IBackend):
+    """A pyusb backend holding one emulated Kinect.
+
+    images: sequence of (480, 640) raw 11-bit depth images the depth stream cycles through.
+    model: "1414", "1473" or "k4w". clock/sleep: time source (time.monotonic/time.sleep, or a
+    VirtualClock to run faster than real time).
+    """
+
+    def __init__(self, images, model: str = "1414", serial: str = DEFAULT_SERIAL, faults: Faults | None = None,
+                 clock=None, sleep=None, bus: int = 1, audio_firmware: bool = False):
+        super().__init__()
+        self.images = [np.asarray(img, dtype=np.uint16) for img in images]
+        if not self.images:
+            raise ValueError("the emulated Kinect needs at least one depth image")
+        self.model = model
+        self._packed = [pack_11bit(img) for img in self.images]   # once: the wire format of each image
+        self.faults = faults or Faults()
+        if isinstance(clock, VirtualClock) and sleep is None:
+            sleep = clock.sleep
+        self.clock = clock or time.monotonic
+        self.sleep = sleep or time.sleep
+        self.bus = bus
+        self._lock = threading.RLock()
+        self._generation = 0
+        self._addresses = itertools.count(5)
+        self._stream_ids = itertools.count(1)
+        self._first_start: float | None = None
+        self._manual_plugged = True
+        self.functions = build_functions(model, serial, audio_firmware)
+        self._bulk_replies: list[bytes] = []
+        self._assign_addresses()
+        self._power_on()
+        self.streams: list[DepthPacketizer] = []
+        self.register_log: list[tuple[int, int, bool]] = []   # (reg, value, iso transfers were queued)
+
+    def expected_frame(self, timestamp: int) -> tuple[int, int]:
+        """(stream number, frame number in that stream) that a delivered frame's timestamp belongs to."""
+        for n, packetizer in enumerate(self.streams):
+            offset = (timestamp - packetizer.first_timestamp) & 0xFFFFFFFF
+            if offset % TICKS_PER_FRAME == 0:
+                return n, offset // TICKS_PER_FRAME
+        raise KeyError(f"timestamp {timestamp} belongs to no emulated stream")
+
+    def expected_raw(self, timestamp: int) -> np.ndarray:
+        """The depth image the emulated device sent with this timestamp."""
+        _, frame = self.expected_frame(timestamp)
+        return self.images[frame % len(self.images)]
+
+    def _assign_addresses(self) -> None:
+        for fn in self.functions:
+            fn.address = next(self._addresses)
+
+    def _power_on(self) -> None:
+        self.registers: dict[int, int] = {}
+        self.depth_stream: _DepthStreamState | None = None
+        self._pending_reply: bytes | None = None
+        self._reply_delay = 0
+        self.motor = EmulatedMotor(self.clock)
+
+    # --- plug state --------------------------------------------------------------------------------------
+    def _scheduled_plugged(self) -> bool:
+        f = self.faults
+        if self._first_start is None or f.unplug_at is None:
+            return True
+        t = self.clock() - self._first_start
+        return not (t >= f.unplug_at and (f.replug_at is None or t < f.replug_at))
+
+    @property
+    def plugged(self) -> bool:
+        return self._manual_plugged and self._scheduled_plugged()
+
+    def unplug(self) -> None:
+        with self._lock:
+            self._manual_plugged = False
+            self._update_plug()
+
+    def replug(self) -> None:
+        with self._lock:
+            self._manual_plugged = True
+            self._update_plug()
+
+    def _update_plug(self) -> None:
+        """Apply a plug change: unplugging invalidates every handle and resets the device on power-up."""
+        plugged = self.plugged
+        if not plugged and self._generation >= 0:
+            self._generation = -(self._generation + 1)       # negative: unplugged
+        elif plugged and self._generation < 0:
+            self._generation = -self._generation
+            self._assign_addresses()
+            self._power_on()
+
+    def check_handle(self, handle: _Handle) -> None:
+        with self._lock:
+            self._update_plug()
+            if handle.generation != self._generation:
+                self._no_device()
+
+    # --- IBackend: enumeration and descriptors -----------------------------------------------------------
+    def enumerate_devices(self):
+        with self._lock:
+            self._update_plug()
+            return list(self.functions) if self._generation >= 0 else []
+
+    def get_device_descriptor(self, dev):
+        return dev.device_descriptor(self.bus)
+
+    def get_configuration_descriptor(self, dev, config):
+        if config != 0:
+            raise IndexError(config)
+        return dev.configuration_descriptor()
+
+    def get_interface_descriptor(self, dev, intf, alt, config):
+        return dev.interfaces[intf][alt]          # IndexError past the last alt setting, as pyusb expects
+
+    def get_endpoint_descriptor(self, dev, ep, intf, alt, config):
+        return dev.interfaces[intf][alt].endpoints[ep]
+
+    # --- IBackend: handles ----------------------------------------------------------------------------------
+    def open_device(self, dev):
+        with self._lock:
+            self._update_plug()
+            if self._generation < 0 or dev not in self.functions:
+                self._no_device()
+            if self.faults.access_denied:
+                raise USBError("Access denied (insufficient permissions)", LIBUSB_ERROR_ACCESS, errno.EACCES)
+            return _Handle(dev, self._generation)
+
+    def close_device(self, dev_handle):
+        pass
+
+    def set_configuration(self, dev_handle, config_value):
+        self.check_handle(dev_handle)
+
+    def get_configuration(self, dev_handle):
+        self.check_handle(dev_handle)
+        return 1
+
+    def set_interface_altsetting(self, dev_handle, intf, altsetting):
+        self.check_handle(dev_handle)
+        if altsetting >= len(dev_handle.function.interfaces[intf]):
+            self._stall()
+        dev_handle.alt[intf] = altsetting
+
+    def claim_interface(self, dev_handle, intf):
+        self.check_handle(dev_handle)
+        dev_handle.claimed.add(intf)
+
+    def release_interface(self, dev_handle, intf):
+        dev_handle.claimed.discard(intf)
+
+    def is_kernel_driver_active(self, dev_handle, intf):
+        self.check_handle(dev_handle)
+        return False
+
+    def detach_kernel_driver(self, dev_handle, intf):
+        self.check_handle(dev_handle)
+
+    def attach_kernel_driver(self, dev_handle, intf):
+        self.check_handle(dev_handle)
+
+    # --- IBackend: control transfers ------------------------------------------------------------------------
+    def ctrl_transfer(self, dev_handle, bmRequestType, bRequest, wValue, wIndex, data, timeout):
+        with self._lock:
+            self.check_handle(dev_handle)
+            fn = dev_handle.function
+            if bmRequestType == 0x80 and bRequest == 6 and (wValue >> 8) == 3:
+                return self._string_descriptor(fn, wValue & 0xFF, data)
+            if fn.kind == "camera":
+                return self._camera_control(bmRequestType, bRequest, wValue, wIndex, data)
+            if fn.kind == "motor":
+                return self._motor_control(bmRequestType, bRequest, wValue, data)
+            self._stall()
+
+    @staticmethod
+    def _fill(data, payload: bytes) -> int:
+        n = min(len(payload), len(data))
+        data[:n] = array.array("B", payload[:n])
+        return n
+
+    def _string_descriptor(self, fn: UsbFunction, index: int, data) -> int:
+        if index == 0:
+            return self._fill(data, bytes([4, 3, 0x09, 0x04]))
+        text = fn.strings().get(index)
+        if not text:
+            self._stall()
+        body = text.encode("utf-16-le")
+        return self._fill(data, bytes([2 + len(body), 3]) + body)
+
+    def _stall(self):
+        raise USBError("Pipe error", LIBUSB_ERROR_PIPE, errno.EPIPE)
+
+    def _no_device(self):
+        raise USBError("No such device (it may have been disconnected)", LIBUSB_ERROR_NO_DEVICE, errno.ENODEV)
+
+    def _camera_control(self, rtype, request, value, index, data) -> int:
+        if rtype == P.CMD_REQUEST_OUT and request == 0 and value == 0 and index == 0:
+            self._camera_command(bytes(data))
+            return len(data)
+        if rtype == P.CMD_REQUEST_IN and request == 0 and value == 0 and index == 0:
+            if self._pending_reply is None or self._reply_delay > 0:
+                self._reply_delay -= 1
+                return 0                       # not ready yet: the host polls again
+            reply, self._pending_reply = self._pending_reply, None
+            return self._fill(data, reply)
+        self._stall()
+
+    def _camera_command(self, message: bytes) -> None:
+        """Execute one GM command; malformed commands stall the pipe and leave no reply."""
+        if len(message) < P.HEADER_SIZE or len(message) % 2:
+            self._stall()
+        hdr = P.parse_header(message)
+        payload = message[P.HEADER_SIZE:]
+        if hdr.magic != P.MAGIC_COMMAND or hdr.words * 2 != len(payload):
+            self._stall()
+        args = struct.unpack(f"<{len(payload) // 2}H", payload)
+        reply = self._execute(hdr.opcode, args)
+        if reply is None:
+            self._stall()
+        self._pending_reply = P._HEADER.pack(P.MAGIC_REPLY, len(reply) // 2, hdr.opcode, hdr.tag) + reply
+        self._reply_delay = 1
+
+    def _execute(self, opcode: int, args: tuple) -> bytes | None:
+        if opcode == P.OP_READ_REGISTER and len(args) == 1:
+            return P.words(args[0], self.registers.get(args[0], 0))
+        if opcode == P.OP_WRITE_REGISTER and len(args) == 2:
+            self._write_register(*args)
+            return P.words(0)
+        if opcode == P.OP_FIXED_PARAMS and len(args) == 5:
+            size = 322 if self.model == "1414" else 334
+            body = bytearray(size)
+            struct.pack_into("<4f", body, 94, *FIXED_PARAMS)
+            return bytes(body)
+        if opcode == P.OP_ALGORITHM_PARAMS and len(args) == 5:
+            sizes = {P.ALGO_CONST_SHIFT: 4, 0x40: 118, 0x41: 8}
+            if args[0] not in sizes:
+                return None
+            body = bytearray(sizes[args[0]])
+            if args[0] == P.ALGO_CONST_SHIFT:
+                struct.pack_into("<H", body, 2, CONST_SHIFT)
+            return bytes(body)
+        return None
+
+    def _write_register(self, reg: int, value: int) -> None:
+        self.registers[reg] = value
+        pump = getattr(self, "last_pump", None)
+        self.register_log.append((reg, value, bool(pump and pump.running)))
+        if reg != P.REG_DEPTH_STREAM:
+            return
+        if value == 0:
+            self.depth_stream = None
+            return
+        ready = (self.registers.get(P.REG_DEPTH_FORMAT) == 3 and self.registers.get(P.REG_DEPTH_RESOLUTION) == 1
+                 and self.registers.get(P.REG_DEPTH_FPS) == 30)
+        if value == 2 and ready:
+            now = self.clock()
+            if self._first_start is None:
+                self._first_start = now
+            sid = next(self._stream_ids)
+            seq0 = (sid * 97) & 0xFF                     # streams do not restart at sequence 0
+            packetizer = DepthPacketizer(self.images, seq0, sid * 12_345_678, packed=self._packed)
+            self.depth_stream = _DepthStreamState(sid, now, packetizer)
+            self.streams.append(packetizer)
+
+    def _motor_control(self, rtype, request, value, data) -> int:
+        try:
+            reply = self.motor.control(rtype, request, value)
+        except Rejected:
+            self._stall()
+        return 0 if reply is None else self._fill(data, reply)
+
+    # --- audio-chip motor commands (bulk; only with the audio firmware running) ----------------------------
+    def bulk_write(self, dev_handle, ep, intf, data, timeout):
+        with self._lock:
+            self.check_handle(dev_handle)
+            fn = dev_handle.function
+            if fn.kind != "audio" or len(fn.interfaces) < 2 or ep != 0x01:
+                self._stall()
+            try:
+                self._bulk_replies += self.motor.audio_command(bytes(data))
+            except Rejected:
+                self._stall()
+            return len(data)
+
+    def bulk_read(self, dev_handle, ep, intf, buff, timeout):
+        with self._lock:
+            self.check_handle(dev_handle)
+            if ep != 0x81 or not self._bulk_replies:
+                raise USBError("Operation timed out", LIBUSB_ERROR_TIMEOUT, errno.ETIMEDOUT)
+            return self._fill(buff, self._bulk_replies.pop(0))
+
+    # --- the iso seam -------------------------------------------------------------------------------------
+    def open_iso_pump(self, dev_handle, endpoint: int, transfers: int, packets_per_transfer: int):
+        self.check_handle(dev_handle)
+        if endpoint != P.DEPTH_ENDPOINT:
+            self._stall()
+        self.last_pump = EmulatedIsoPump(self, dev_handle, endpoint, transfers, packets_per_transfer)
+        return self.last_pump
