@@ -22,10 +22,11 @@ from kinect_retarget.device.disparity_calibration import Calibration  # noqa: E4
 from kinect_retarget.device.decode import decode_frame  # noqa: E402
 from kinect_retarget.sim.depth_sequences import load_fakenect_dir  # noqa: E402
 from kinect_retarget.sim.emulated_kinect import EmulatedKinect  # noqa: E402
-from kinect_retarget.sim.emulated_stream import DepthPacketizer, EmulatedIsoPump, VirtualClock  # noqa: E402
+from kinect_retarget.sim.emulated_stream import DepthPacketizer, VirtualClock  # noqa: E402
 from kinect_retarget.device.protocol import DEPTH_PACKETS_PER_FRAME  # noqa: E402
 from kinect_retarget.device.reassembly import FrameAssembler  # noqa: E402
 from kinect_retarget.device.depth_stream import DepthStream  # noqa: E402
+from kinect_retarget.device.usb_backend import open_iso_pump  # noqa: E402
 
 from _common import shared_data_or_skip  # noqa: E402
 
@@ -70,7 +71,7 @@ def emulator_cost_per_second(images) -> float:
     from kinect_retarget.device.discovery import find_kinect
     info = find_kinect(emu)
     camera = KinectCamera(info.camera).open()
-    pump = EmulatedIsoPump(emu, info.camera._ctx.managed_open(), 0x82, 16, 32)
+    pump = open_iso_pump(info.camera, 0x82, 16, 32)
     pump.start()
     camera.start_depth()
     t0 = time.thread_time()

@@ -84,6 +84,7 @@ class DepthStream:
         self._lock = threading.Lock()
         self._status = StreamStatus(STOPPED, "not started", 0.0, 0, 0, 0, 0, "", 0, 0.0)
         self._recent = collections.deque(maxlen=31)
+        self._stuck: list = []     # (pump, camera) whose transfers libusb never handed back
 
     # --- public API ---------------------------------------------------------------------------------------
     @property
@@ -163,7 +164,8 @@ class DepthStream:
                 # errors (no permission, no driver) are retried too, but slowly: the user may be fixing them
                 self._stop.wait(self.reconnect_interval * (4 if self._status.state == ERROR else 1))
         finally:
-            self._set(state=STOPPED, message="stopped", fps=0.0, thread_cpu_s=time.thread_time())
+            stuck = f"stopped, but {self._stuck[-1][0].stuck}" if self._stuck else "stopped"
+            self._set(state=STOPPED, message=stuck, fps=0.0, thread_cpu_s=time.thread_time())
 
     def _stream_once(self) -> None:
         info = find_kinect(self._backend, self.serial)
@@ -191,9 +193,13 @@ class DepthStream:
                 raise DeviceGone("the Kinect was unplugged") from exc
             raise KinectError(f"USB error: {exc}") from exc
         finally:
-            if pump is not None:
-                pump.stop()
-            camera.close()
+            if pump is not None and not pump.stop():
+                # libusb still owns transfers on this handle: closing it would let libusb write into freed
+                # memory, so the camera and pump stay alive (and open) for good, and the status says so
+                self._stuck.append((pump, camera))
+                log.error("depth stream: %s", pump.stuck)
+            else:
+                camera.close()
 
     def _pump_loop(self, pump, calibration: Calibration, lut: np.ndarray) -> None:
         assembler = FrameAssembler()

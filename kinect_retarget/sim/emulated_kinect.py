@@ -23,7 +23,8 @@ from usb.core import USBError
 from ..device import protocol as P
 from ..device.depth_unpack import pack_11bit
 from .emulated_motor import EmulatedMotor, Rejected
-from .emulated_stream import DepthPacketizer, EmulatedIsoPump, Faults, VirtualClock
+from .emulated_libusb import EmulatedLibusb
+from .emulated_stream import DepthPacketizer, FaultyWire, Faults, VirtualClock
 from .emulated_usb import UsbFunction, build_functions
 from ..device.protocol import TICKS_PER_FRAME
 from ..device.usb_backend import LIBUSB_ERROR_NO_DEVICE
@@ -36,12 +37,24 @@ CONST_SHIFT = 200
 FIXED_PARAMS = (7.5, 2.4, 120.0, 0.1052)       # emitter dist (cm), rcmos dist (cm), ref dist (mm), pixel (mm)
 
 
+_handle_ids = itertools.count(1)
+
+
 @dataclass
 class _Handle:
     function: UsbFunction
     generation: int
     claimed: set = field(default_factory=set)
     alt: dict = field(default_factory=dict)
+    id: int = field(default_factory=lambda: next(_handle_ids))
+
+    @property
+    def handle(self) -> int:          # what libusb's transfers carry as dev_handle (see emulated_libusb.py)
+        return self.id
+
+    @property
+    def devid(self) -> UsbFunction:
+        return self.function
 
 
 @dataclass
@@ -83,6 +96,10 @@ class EmulatedKinect(usb.backend.IBackend):
         self._bulk_replies: list[bytes] = []
         self._assign_addresses()
         self._power_on()
+        self._handles: dict[int, _Handle] = {}
+        self._wire = FaultyWire(self.faults)
+        self.lib = EmulatedLibusb(self)         # its libusb: the driver's LibusbIsoPump streams through it
+        self.ctx = None
         self.streams: list[DepthPacketizer] = []
         self.register_log: list[tuple[int, int, bool]] = []   # (reg, value, iso transfers were queued)
 
@@ -142,6 +159,22 @@ class EmulatedKinect(usb.backend.IBackend):
             self._assign_addresses()
             self._power_on()
 
+    def refresh_plug(self) -> bool:
+        """Apply scheduled plug changes; True while the Kinect is on the bus."""
+        with self._lock:
+            self._update_plug()
+            return self._generation >= 0
+
+    def handle_by_id(self, handle_id) -> _Handle | None:
+        return self._handles.get(handle_id)
+
+    def handle_alive(self, handle: _Handle) -> bool:
+        return self.refresh_plug() and handle.generation == self._generation
+
+    def wire_packet(self, stream: "_DepthStreamState", index: int) -> bytes | None:
+        """Packet `index` of a depth stream as it reaches the host: None if the wire lost it."""
+        return self._wire.packet(stream.packetizer, index)
+
     def check_handle(self, handle: _Handle) -> None:
         with self._lock:
             self._update_plug()
@@ -176,10 +209,16 @@ class EmulatedKinect(usb.backend.IBackend):
                 self._no_device()
             if self.faults.access_denied:
                 raise USBError("Access denied (insufficient permissions)", LIBUSB_ERROR_ACCESS, errno.EACCES)
-            return _Handle(dev, self._generation)
+            handle = _Handle(dev, self._generation)
+            self._handles[handle.id] = handle
+            return handle
 
     def close_device(self, dev_handle):
-        pass
+        self.lib.handle_closed(dev_handle)
+        self._handles.pop(dev_handle.id, None)
+
+    def reset_device(self, dev_handle):
+        self.check_handle(dev_handle)
 
     def set_configuration(self, dev_handle, config_value):
         self.check_handle(dev_handle)
@@ -295,8 +334,7 @@ class EmulatedKinect(usb.backend.IBackend):
 
     def _write_register(self, reg: int, value: int) -> None:
         self.registers[reg] = value
-        pump = getattr(self, "last_pump", None)
-        self.register_log.append((reg, value, bool(pump and pump.running)))
+        self.register_log.append((reg, value, self.lib.in_flight > 0))
         if reg != P.REG_DEPTH_STREAM:
             return
         if value == 0:
@@ -340,11 +378,3 @@ class EmulatedKinect(usb.backend.IBackend):
             if ep != 0x81 or not self._bulk_replies:
                 raise USBError("Operation timed out", LIBUSB_ERROR_TIMEOUT, errno.ETIMEDOUT)
             return self._fill(buff, self._bulk_replies.pop(0))
-
-    # --- the iso seam -------------------------------------------------------------------------------------
-    def open_iso_pump(self, dev_handle, endpoint: int, transfers: int, packets_per_transfer: int):
-        self.check_handle(dev_handle)
-        if endpoint != P.DEPTH_ENDPOINT:
-            self._stall()
-        self.last_pump = EmulatedIsoPump(self, dev_handle, endpoint, transfers, packets_per_transfer)
-        return self.last_pump

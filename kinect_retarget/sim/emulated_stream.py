@@ -1,22 +1,17 @@
 """The emulated Kinect's isochronous depth stream: packets on a 125 µs microframe clock, with fault injection.
 
 DepthPacketizer cuts packed frames into the device's 242 packets (headers, sequence numbers, 60 MHz
-timestamps). EmulatedIsoPump is the emulated side of the usb_backend seam: it hands out the packets that
-have "arrived" by the clock, and loses the ones that arrived while the host had no transfer in flight,
-exactly like a real host that fell behind.
+timestamps). FaultyWire applies the injected faults to each packet; emulated_libusb.py delivers the packets
+to the driver's transfers on the microframe clock.
 """
 from __future__ import annotations
 
-import math
 import threading
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from usb.core import USBError
-
 from ..device.depth_unpack import pack_11bit
-from ..device.errors import DeviceGone
 from ..device.protocol import (DEPTH_LAST_PAYLOAD, DEPTH_PACKETS_PER_FRAME, DEPTH_PAYLOAD, PACKET_HEADER_SIZE,
                        TICKS_PER_FRAME, build_packet_header, depth_packet_flag)
 
@@ -34,6 +29,14 @@ class Faults:
     replug_at: float | None = None
     access_denied: bool = False                # open() fails as without a udev rule
     seed: int = 0
+    # --- what real hosts and devices do (libfreenect issues in docs/usb_driver.md) ---
+    unplug_cancels: bool = False               # on unplug transfers come back CANCELLED (libusb on macOS)
+    submit_io_error: bool = False              # every iso submit fails with LIBUSB_ERROR_IO (bandwidth)
+    submit_io_error_at: tuple[int, ...] = ()   # these iso submits (1 = the first) fail with LIBUSB_ERROR_IO
+    cancel_delay_s: float = 0.0                # real seconds before a cancelled transfer comes back (inf: never)
+    write_ack_bytes: int = 2                   # register writes answered with 2 bytes (0000) or 4 (00000000)
+    reply_padding: bool = False                # every control IN returns 0x200 bytes (Windows, issue #494)
+    command_eio: bool = False                  # camera control transfers fail with EIO (device still there)
 
 
 class DepthPacketizer:
@@ -47,6 +50,12 @@ class DepthPacketizer:
 
     def timestamp(self, frame: int) -> int:
         return (self.first_timestamp + frame * TICKS_PER_FRAME) & 0xFFFFFFFF
+
+    @staticmethod
+    def packet_length(index: int) -> int:
+        """Bytes of packet `index` as the device sends it, header included."""
+        last = index % DEPTH_PACKETS_PER_FRAME == DEPTH_PACKETS_PER_FRAME - 1
+        return (DEPTH_LAST_PAYLOAD if last else DEPTH_PAYLOAD) + PACKET_HEADER_SIZE
 
     def packet(self, index: int) -> bytes:
         """Packet number `index` of the stream (all frames back to back)."""
@@ -65,6 +74,13 @@ def packet_due_time(index: int) -> float:
     return frame * FRAME_S + (j + 1) * MICROFRAME_S
 
 
+def packet_microframe(index: int) -> int:
+    """The microframe (counted from the stream's start) that carries packet `index`: one packet per
+    microframe, 242 of the ~267 in each 1/30 s frame."""
+    frame, j = divmod(index, DEPTH_PACKETS_PER_FRAME)
+    return (frame * 8000) // 30 + j + 1
+
+
 class VirtualClock:
     """A clock that jumps instead of sleeping, so emulated streams can run faster than real time."""
 
@@ -80,95 +96,24 @@ class VirtualClock:
             self.now += max(seconds, 0.0)
 
 
-class EmulatedIsoPump:
-    """Emulated implementation of the iso transfer seam (see usb_backend.IsoPump)."""
+class FaultyWire:
+    """What the wire does to each packet under the injected faults: loses it (None), cuts it short, or not."""
 
-    def __init__(self, device, handle, endpoint: int, transfers: int, packets_per_transfer: int):
-        self._device = device          # the EmulatedKinect
-        self._handle = handle
-        self.endpoint = endpoint
-        self.window_s = transfers * packets_per_transfer * MICROFRAME_S   # what the host keeps armed
-        self.transfer_s = packets_per_transfer * MICROFRAME_S              # packets reach the host per transfer
-        self._armed_until: float | None = None
-        self._next = 0                 # next packet index of the current stream
-        self._stream_id = None
-        self._rng = np.random.default_rng(device.faults.seed)
-        self._lost_set = self._burst_set(device.faults)
-        self._truncate = {(f, p): keep for f, p, keep in device.faults.truncate}
-        self.running = False
-        self.faulted: dict[tuple[int, int], int] = {}   # (stream id, frame) -> packets lost or truncated
-        self.overrun_packets = 0                       # lost because the host had no transfer in flight
-
-    @staticmethod
-    def _burst_set(faults: Faults) -> set[int]:
-        lost = set()
+    def __init__(self, faults: Faults):
+        self._rng = np.random.default_rng(faults.seed)
+        self._loss_rate = faults.loss_rate
+        self._lost = set()
         for frame, first, count in faults.bursts:
             base = frame * DEPTH_PACKETS_PER_FRAME + first
-            lost.update(range(base, base + count))
-        return lost
+            self._lost.update(range(base, base + count))
+        self._truncate = {(f, p): keep for f, p, keep in faults.truncate}
 
-    def start(self) -> None:
-        self._device.check_handle(self._handle)
-        self.running = True
-        self._armed_until = self._device.clock() + self.window_s
-
-    def stop(self) -> None:
-        self.running = False
-
-    def poll(self, timeout: float) -> list:
-        """Packets that arrived since the last poll (None = a slot the host saw fail); [] on timeout."""
-        dev = self._device
-        deadline = dev.clock() + timeout
-        while True:
-            try:
-                dev.check_handle(self._handle)
-            except USBError as exc:
-                raise DeviceGone("the Kinect was unplugged") from exc
-            stream = dev.depth_stream
-            now = dev.clock()
-            if stream is not None:
-                if stream.id != self._stream_id:
-                    self._stream_id, self._next = stream.id, 0
-                packets = self._collect(stream, now)
-                self._armed_until = now + self.window_s
-                if packets:
-                    return packets
-                due = packet_due_time(self._next)
-                wake = stream.start_time + math.ceil(due / self.transfer_s) * self.transfer_s
-            else:
-                self._armed_until = now + self.window_s
-                wake = deadline
-            if now >= deadline:
-                return []
-            dev.sleep(max(min(wake, deadline) - now, 0.0) + 1e-4)
-
-    def _collect(self, stream, now: float) -> list:
-        out = []
-        faults = self._device.faults
-        # like libusb, hand packets over a whole transfer at a time, when the transfer completes
-        elapsed = math.floor((now - stream.start_time) / self.transfer_s) * self.transfer_s
-        armed = self._armed_until - stream.start_time
-        while True:
-            due = packet_due_time(self._next)
-            if due > elapsed:
-                break
-            i = self._next
-            self._next += 1
-            if due > armed:
-                self.overrun_packets += 1                   # no transfer was in flight: gone for good
-                continue
-            key = (stream.id, i // DEPTH_PACKETS_PER_FRAME)
-            if i in self._lost_set or (faults.loss_rate and self._rng.random() < faults.loss_rate):
-                self.faulted[key] = self.faulted.get(key, 0) + 1
-                out.append(None)
-                continue
-            packet = stream.packetizer.packet(i)
-            keep = self._truncate.get(divmod(i, DEPTH_PACKETS_PER_FRAME))
-            if keep is not None:
-                self.faulted[key] = self.faulted.get(key, 0) + 1
-                packet = packet[:keep]
-            out.append(packet)
-        return out
+    def packet(self, packetizer: DepthPacketizer, index: int) -> bytes | None:
+        if index in self._lost or (self._loss_rate and self._rng.random() < self._loss_rate):
+            return None
+        packet = packetizer.packet(index)
+        keep = self._truncate.get(divmod(index, DEPTH_PACKETS_PER_FRAME))
+        return packet if keep is None else packet[:keep]
 
 
 def packets_for_frames(images: list[np.ndarray], n_frames: int, first_seq: int = 0,

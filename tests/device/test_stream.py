@@ -44,7 +44,7 @@ def test_ninety_frames_every_frame_bit_exact(real_depth):
         np.testing.assert_array_equal(f.mm, lut[f.raw])
         assert f.lost_packets == 0
     assert (status.frames_dropped, status.packets_lost, status.queue_overflows) == (0, 0, 0)
-    assert emu.last_pump.overrun_packets == 0
+    assert emu.lib.overrun_packets == 0
     assert stream.status.state == STOPPED
 
 
@@ -58,7 +58,7 @@ def test_injected_loss_drops_exactly_the_frames_with_more_than_five_lost(real_de
     stream.stop()
     got = {emu.expected_frame(f.timestamp)[1]: f for f in frames}
     last = max(got)
-    lost = {frame: n for (_, frame), n in emu.last_pump.faulted.items() if frame <= last}
+    lost = {frame: n for (_, frame), n in emu.lib.faulted.items() if frame <= last}
     expected = {k for k in range(last + 1) if lost.get(k, 0) <= 5}
     assert set(got) == expected
     assert 5 not in got and lost[5] >= 6
