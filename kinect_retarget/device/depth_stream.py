@@ -17,11 +17,12 @@ import numpy as np
 import usb.core
 
 from .disparity_calibration import Calibration
-from .kinect_camera import KinectCamera, is_gone
+from .kinect_camera import KinectCamera, usb_failure
 from .decode import decode_frame
 from .discovery import KinectInfo, find_kinect
 from .errors import DeviceGone, DeviceNotFound, KinectError
-from .protocol import DEPTH_ENDPOINT
+from .motor import send_keep_alive
+from .protocol import DEPTH_ENDPOINT, is_model_1414
 from .reassembly import FrameAssembler
 from .usb_backend import DEFAULT_PACKETS_PER_TRANSFER, DEFAULT_TRANSFERS, open_iso_pump
 
@@ -29,6 +30,22 @@ log = logging.getLogger(__name__)
 
 STOPPED, CONNECTING, STREAMING, UNPLUGGED, WAITING, ERROR = (
     "stopped", "connecting", "streaming", "unplugged", "waiting for device", "error")
+
+
+NO_FRAME_TIMEOUT_S = 2.0      # a stream that delivers no frame this long says why it probably does not
+
+
+def no_frame_diagnosis(packets: int, seconds: float) -> str:
+    """What a started stream that delivers no frame for `seconds` most likely means."""
+    if packets == 0:
+        return (f"streaming, but no depth data arrived for {seconds:g} s. Likely causes: the Kinect's 12 V adapter "
+                "is unplugged (its camera enumerates but the projector and sensor stay off); the USB controller "
+                "does not deliver isochronous data from it (some USB 3 controllers: try a USB 2 port, or a USB 2 "
+                "hub); another program or camera is using the same controller")
+    return (f"streaming, but no complete depth frame for {seconds:g} s although {packets} packets arrived: too "
+            "many are lost. Likely causes: other devices on the same USB controller take its bandwidth (unplug "
+            "other cameras, or use a port on another controller); a USB 3 controller that mangles isochronous "
+            "data (try a USB 2 port or a USB 2 hub); a damaged cable or unpowered hub")
 
 
 @dataclass(frozen=True)
@@ -67,7 +84,7 @@ class DepthStream:
     def __init__(self, source=None, *, serial: str | None = None, queue_size: int = 8, convert_mm: bool = True,
                  packet_hook=None, transfers: int = DEFAULT_TRANSFERS,
                  packets_per_transfer: int = DEFAULT_PACKETS_PER_TRANSFER, reconnect_interval: float = 0.25,
-                 poll_timeout: float = 0.02):
+                 poll_timeout: float = 0.02, no_frame_timeout: float = NO_FRAME_TIMEOUT_S):
         if isinstance(source, KinectInfo):
             self._backend, serial = source.camera._ctx.backend, serial or source.serial
         else:
@@ -79,6 +96,8 @@ class DepthStream:
         self._transfers, self._ppt = transfers, packets_per_transfer
         self.reconnect_interval = reconnect_interval
         self.poll_timeout = poll_timeout
+        self.no_frame_timeout = no_frame_timeout
+        self._streaming_message = ""
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._lock = threading.Lock()
@@ -174,6 +193,11 @@ class DepthStream:
         self.serial = self.serial or info.serial
         self._set(state=CONNECTING, message=f"opening {info.model} {info.serial}",
                   device=f"{info.model} {info.serial}")
+        warning = ""
+        if not is_model_1414(info.camera.idProduct, info.camera.bcdDevice):
+            warning = send_keep_alive(info.audio)         # before the camera is claimed, as libfreenect does
+            if warning:
+                log.warning("%s %s: %s", info.model, info.serial, warning)
         camera = KinectCamera(info.camera)
         pump = None
         try:
@@ -182,16 +206,16 @@ class DepthStream:
             pump = open_iso_pump(info.camera, DEPTH_ENDPOINT, self._transfers, self._ppt)
             pump.start()                                      # transfers queued before the stream starts
             camera.start_depth()
-            self._set(state=STREAMING, message=f"streaming from {info.model} {info.serial}")
+            self._streaming_message = f"streaming from {info.model} {info.serial}" + (
+                f" ({warning})" if warning else "")
+            self._set(state=STREAMING, message=self._streaming_message)
             self._pump_loop(pump, camera.calibration, lut)
             try:
                 camera.stop_depth()
             except KinectError:
                 pass
         except usb.core.USBError as exc:
-            if is_gone(exc):
-                raise DeviceGone("the Kinect was unplugged") from exc
-            raise KinectError(f"USB error: {exc}") from exc
+            raise usb_failure(exc, "a USB transfer") from exc
         finally:
             if pump is not None and not pump.stop():
                 # libusb still owns transfers on this handle: closing it would let libusb write into freed
@@ -205,10 +229,20 @@ class DepthStream:
         assembler = FrameAssembler()
         base_dropped = self._status.frames_dropped
         base_lost = self._status.packets_lost
+        last_frame, frames_before, packets_seen, complained = time.monotonic(), self._status.frames, 0, False
         while not self._stop.is_set():
             packets = pump.poll(self.poll_timeout)
+            if self._status.frames != frames_before:      # a frame came: the stream is fine (again)
+                last_frame, frames_before, packets_seen = time.monotonic(), self._status.frames, 0
+                if complained:
+                    self._set(message=self._streaming_message)
+                    complained = False
+            elif not complained and time.monotonic() - last_frame > self.no_frame_timeout:
+                self._set(message=no_frame_diagnosis(packets_seen, self.no_frame_timeout), fps=0.0)
+                complained = True
             if not packets:
                 continue
+            packets_seen += len(packets)
             if self.packet_hook is not None:
                 self.packet_hook(packets)
             for done in assembler.feed(packets):

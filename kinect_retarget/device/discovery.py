@@ -27,8 +27,11 @@ def udev_rule_install_command() -> str:
 
 
 MOTOR_FIRMWARE_NOTE = ("tilt, LED and accelerometer on this model go through the audio chip and only work after "
-                       "its proprietary firmware is uploaded (e.g. by the Kinect SDK or libfreenect's "
-                       "fwfetcher); it is not included. Depth streaming works without it.")
+                       "its proprietary firmware (audios.bin) has been uploaded to it. That file is not included "
+                       "and may not be redistributed: libfreenect's src/fwfetcher.py extracts it from a "
+                       "Microsoft Xbox 360 system update; put it in ~/.libfreenect/ and open the Kinect with "
+                       "libfreenect once (or the Kinect SDK on Windows), which uploads it until the next unplug. "
+                       "Depth streaming works without it.")
 
 
 @dataclass
@@ -44,6 +47,8 @@ class KinectInfo:
     problem: str = ""                 # why the camera cannot be opened, with the fix
     camera: object = field(default=None, repr=False)   # usb.core.Device
     motor: object = field(default=None, repr=False)    # usb.core.Device (1414) or audio device (others)
+    audio: object = field(default=None, repr=False)    # usb.core.Device of the audio chip, if found
+    matched: dict = field(default_factory=dict)        # how motor and audio were paired with the camera
 
     def describe(self) -> str:
         lines = [f"{self.model}  serial {self.serial}  (bus {self.bus}, address {self.address})",
@@ -55,29 +60,66 @@ class KinectInfo:
         return "\n".join(lines)
 
 
-def _hub_key(dev) -> tuple:
+def _parent(dev) -> tuple | None:
+    """The hub port a device hangs off (bus, port path minus its own port), None where the OS won't say."""
     ports = getattr(dev, "port_numbers", None)
-    return (dev.bus, tuple(ports[:-1]) if ports else None)
+    return (dev.bus, tuple(ports[:-1])) if ports else None
 
 
-def _read_serial(dev) -> tuple[str | None, str]:
+def find_sibling(camera, devices, product_ids) -> tuple[object | None, str]:
+    """The motor or audio device that belongs to `camera`, as libfreenect pairs them: the one behind the same
+    hub, else the only one on the camera's bus, else the only one on the system (an xHCI port, or an OS that
+    reports no port path, still gives one Kinect). Returns (device or None, how it was matched)."""
+    candidates = [d for d in devices if d.idProduct in product_ids]
+    parent = _parent(camera)
+    if parent is not None:
+        for d in candidates:
+            if _parent(d) == parent:
+                return d, "same hub"
+    same_bus = [d for d in candidates if d.bus == camera.bus]
+    if len(same_bus) == 1:
+        return same_bus[0], "only one on the bus"
+    if len(candidates) == 1:
+        return candidates[0], "only one on the system"
+    return None, f"{len(candidates)} candidates, none behind the camera's hub" if candidates else "none found"
+
+
+def _read_serial(dev, role: str = "camera") -> tuple[str | None, str]:
     """(serial, problem): opening the device to read its serial string also tests access."""
     try:
-        serial = usb.util.get_string(dev, dev.iSerialNumber) if dev.iSerialNumber else ""
-        return serial or "", ""
-    except (usb.core.USBError, NotImplementedError, ValueError) as exc:
+        try:
+            serial = usb.util.get_string(dev, dev.iSerialNumber) if dev.iSerialNumber else ""
+            return serial or "", ""
+        except ValueError:
+            # pyusb hides why it could not read the language ids ("permission issue, ... or device error"):
+            # opening the device again gives the real error
+            dev._ctx.managed_open()
+            return None, f"the {role} answers no string descriptors (a device error): unplug and replug it"
+    except (usb.core.USBError, NotImplementedError) as exc:
         if isinstance(exc, usb.core.USBError) and is_gone(exc):
             return None, "the device disappeared while it was being read"
-        return None, access_advice(exc)
+        return None, access_advice(exc, role)
     finally:
         usb.util.dispose_resources(dev)
 
 
-def _audio_firmware_running(audio) -> bool:
+def audio_motor_state(audio) -> tuple[bool, str]:
+    """(motor usable, note) for a model whose motor and LED go through the audio chip: its firmware must run
+    (two or more interfaces). A device that cannot even be read is reported as that, not as no firmware."""
+    if audio is None:
+        return False, "the audio device (which carries the motor on this model) was not found on the bus"
     try:
-        return audio is not None and audio.get_active_configuration().bNumInterfaces >= 2
-    except (usb.core.USBError, NotImplementedError):
-        return False
+        if audio.get_active_configuration().bNumInterfaces >= 2:
+            return True, ""
+    except usb.core.USBError as exc:
+        if is_gone(exc):
+            return False, "the audio device disappeared while it was being read"
+        return False, f"the audio device (which carries the motor) cannot be read: {access_advice(exc, 'audio')}"
+    except NotImplementedError as exc:
+        return False, f"the audio device (which carries the motor) cannot be read: {access_advice(exc, 'audio')}"
+    finally:
+        usb.util.dispose_resources(audio)
+    return False, MOTOR_FIRMWARE_NOTE
 
 
 def list_devices(backend=None) -> list[KinectInfo]:
@@ -89,28 +131,25 @@ def list_devices(backend=None) -> list[KinectInfo]:
     backend = backend or find_backend()
     devices = list(usb.core.find(find_all=True, idVendor=P.VENDOR_MICROSOFT, backend=backend))
     cameras = [d for d in devices if d.idProduct in P.CAMERA_PIDS]
-    motors = {_hub_key(d): d for d in devices if d.idProduct in P.MOTOR_PIDS}
-    audios = {_hub_key(d): d for d in devices if d.idProduct in P.AUDIO_PIDS}
     found = []
     for cam in cameras:
-        key = _hub_key(cam)
         serial, problem = _read_serial(cam)
-        audio = audios.get(key)
+        audio, audio_match = find_sibling(cam, devices, P.AUDIO_PIDS)
         if (serial is None or set(serial) <= {"0"}) and audio is not None:
             # 1473 / Kinect for Windows cameras report sixteen zeros: the audio device has the real serial
-            audio_serial, _ = _read_serial(audio)
+            audio_serial, _ = _read_serial(audio, "audio")
             serial = audio_serial or serial
         if P.is_model_1414(cam.idProduct, cam.bcdDevice):
-            motor = motors.get(key)
-            motor_ok, note = motor is not None, "" if key in motors else "motor device not found on the bus"
+            motor, motor_match = find_sibling(cam, devices, P.MOTOR_PIDS)
+            motor_ok, note = motor is not None, "" if motor is not None else "motor device not found on the bus"
         else:
-            motor = audio
-            motor_ok = _audio_firmware_running(audio)
-            note = "" if motor_ok else MOTOR_FIRMWARE_NOTE
+            motor, motor_match = audio, audio_match
+            motor_ok, note = audio_motor_state(audio)
         found.append(KinectInfo(model=P.camera_model(cam.idProduct, cam.bcdDevice), serial=serial or "?",
                                 bus=cam.bus, address=cam.address, camera_available=not problem,
                                 motor_available=motor_ok, motor_note=note, problem=problem,
-                                camera=cam, motor=motor))
+                                camera=cam, motor=motor, audio=audio,
+                                matched={"motor": motor_match, "audio": audio_match}))
     return found
 
 

@@ -5,6 +5,7 @@ Works on any pyusb Device: a real one through the libusb1 backend or the emulate
 from __future__ import annotations
 
 import errno
+import logging
 import sys
 import time
 
@@ -14,30 +15,86 @@ import usb.util
 from . import protocol as P
 from .disparity_calibration import Calibration, calibration_from_replies
 from .errors import AccessDenied, DeviceGone, KinectError, ProtocolError
-from .usb_backend import LIBUSB_ERROR_NO_DEVICE
+from .usb_backend import LIBUSB_ERROR_IO, LIBUSB_ERROR_NO_DEVICE
+
+log = logging.getLogger(__name__)
 
 REPLY_TIMEOUT_S = 1.0
 USB_TIMEOUT_MS = 500
 
 
 def is_gone(exc: BaseException) -> bool:
-    """True when a pyusb error means the device is no longer there."""
+    """True when a pyusb error means the device is no longer there. EIO is not one: libusb reports a failed
+    transfer on a device that is still on the bus (bad cable, hub, power) that way."""
     return isinstance(exc, usb.core.USBError) and (
-        exc.errno in (errno.ENODEV, errno.EIO) or getattr(exc, "backend_error_code", None) == LIBUSB_ERROR_NO_DEVICE)
+        exc.errno == errno.ENODEV or getattr(exc, "backend_error_code", None) == LIBUSB_ERROR_NO_DEVICE)
 
 
-def access_advice(exc: BaseException) -> str:
-    """Why the OS refused to open the device, and the fix for this platform."""
-    if sys.platform.startswith("linux"):
-        if getattr(exc, "errno", None) == errno.EBUSY:
-            return ("the device is busy: another program (libfreenect, a previous Blender session) holds it; "
-                    "close it and try again")
-        return ("permission denied: install the udev rule (print it with "
-                "'python -m kinect_retarget devices --udev-rule'), then unplug and replug the Kinect")
-    if sys.platform == "win32":
-        return ("Windows has no usable driver bound to the Kinect camera: install WinUSB or libusbK for "
-                "'Xbox NUI Camera' with Zadig (https://zadig.akeo.ie)")
-    return f"the OS refused to open the device ({exc})"
+def is_io_error(exc: BaseException) -> bool:
+    return isinstance(exc, usb.core.USBError) and (
+        exc.errno == errno.EIO or getattr(exc, "backend_error_code", None) == LIBUSB_ERROR_IO)
+
+
+IO_ERROR_ADVICE = ("a USB I/O error (EIO): the Kinect is still connected but the transfer failed. Check that its "
+                   "12 V adapter is plugged in, plug it straight into the computer (not through an unpowered "
+                   "hub), or try another port or cable")
+
+# What Zadig lists each Kinect device as (its USB product string and id), to pick the right one there.
+ZADIG_NAMES = {"camera": "'Xbox NUI Camera' (USB ID 045E 02AE; 'Kinect for Windows Camera', 045E 02BF, on a "
+                         "Kinect for Windows)",
+               "motor": "'Xbox NUI Motor' (USB ID 045E 02B0)",
+               "audio": "'Xbox Kinect Audio' (USB ID 045E 02AD; 045E 02BE on a Kinect for Windows), which "
+                        "carries the motor and LED on models 1473 and Kinect for Windows"}
+
+
+def usb_failure(exc: usb.core.USBError, what: str, other=KinectError) -> KinectError:
+    """The error to raise for a failed USB transfer: the device is gone, an I/O error, or `other`."""
+    if is_gone(exc):
+        return DeviceGone("the Kinect was unplugged")
+    if is_io_error(exc):
+        return KinectError(f"{what} failed with {IO_ERROR_ADVICE}")
+    return other(f"{what} failed: {exc}")
+
+
+def access_advice(exc: BaseException, role: str = "camera", platform: str | None = None) -> str:
+    """Why the OS refused to open the device, and the fix for this platform. `role`: camera, motor, audio."""
+    platform = platform or sys.platform
+    code = getattr(exc, "errno", None)
+    if code == errno.EBUSY:
+        return ("the device is busy: another program (libfreenect, a previous Blender session) holds it; "
+                "close it and try again")
+    if platform.startswith("linux"):
+        if code in (errno.EACCES, errno.EPERM):
+            return ("permission denied: install the udev rule (print it with "
+                    "'python -m kinect_retarget devices --udev-rule'), then unplug and replug the Kinect")
+        return f"the OS refused to open the Kinect {role} ({exc})"
+    if platform == "win32":
+        return (f"Windows has no usable driver bound to the Kinect {role}: in Zadig (https://zadig.akeo.ie), "
+                f"Options > List All Devices, pick {ZADIG_NAMES.get(role, role)} and install libusbK (or WinUSB)")
+    if platform == "darwin":
+        return (f"macOS needs no driver or permission setup for a Kinect, so the {role} could not be opened "
+                f"for another reason ({exc}): unplug and replug it, and close other programs using it")
+    return f"the OS refused to open the Kinect {role} ({exc})"
+
+
+def padded_reply(reply: bytes, opcode: int, tag: int) -> bytes | None:
+    """A reply returned in a full 0x200-byte buffer (some Windows hosts): the reply its header announces,
+    if that header answers this command; None for a buffer that holds no reply (poll again)."""
+    try:
+        hdr = P.parse_header(reply)
+    except ProtocolError:
+        return None
+    size = P.HEADER_SIZE + 2 * hdr.words
+    if hdr.magic != P.MAGIC_REPLY or hdr.opcode != opcode or hdr.tag != tag or size > len(reply):
+        return None
+    return bytes(reply[:size])
+
+
+def full_reply_advice(opcode: int) -> str:
+    return (f"no reply to camera command {opcode:#x}: every poll came back as a full 0x200-byte buffer without "
+            "one, a known problem of some USB host controllers and Windows drivers (libfreenect issue #494). "
+            "Try another USB port or controller (a USB 2 port), and on Windows the libusbK driver "
+            f"(Zadig: {ZADIG_NAMES['camera']})")
 
 
 class KinectCamera:
@@ -51,6 +108,8 @@ class KinectCamera:
         self._tag = 0
         self._claimed = False
         self.calibration = Calibration()
+        self.padded_replies = 0            # replies taken out of a full 0x200-byte buffer
+        self.odd_write_acks: list[tuple[int, str]] = []   # (register, reply hex) not answered 0000
 
     # --- open / close -----------------------------------------------------------------------------------
     def open(self) -> "KinectCamera":
@@ -73,6 +132,8 @@ class KinectCamera:
         except usb.core.USBError as exc:
             if is_gone(exc):
                 raise DeviceGone("the Kinect was unplugged while opening it") from exc
+            if is_io_error(exc):
+                raise KinectError(f"cannot open the Kinect camera: {IO_ERROR_ADVICE}") from exc
             if exc.errno in (errno.EACCES, errno.EPERM, errno.EBUSY) or sys.platform == "win32":
                 raise AccessDenied(f"cannot open the Kinect camera: {access_advice(exc)}") from exc
             raise KinectError(f"cannot open the Kinect camera: {exc}") from exc
@@ -101,21 +162,29 @@ class KinectCamera:
         """Send one GM command and return the validated RB reply payload."""
         tag = self._tag
         message = P.build_command(opcode, tag, payload)
+        full = False
         try:
             self.device.ctrl_transfer(P.CMD_REQUEST_OUT, 0, 0, 0, message, USB_TIMEOUT_MS)
             deadline = time.monotonic() + REPLY_TIMEOUT_S
             while True:
                 reply = self.device.ctrl_transfer(P.CMD_REQUEST_IN, 0, 0, 0, P.CMD_REPLY_LENGTH, USB_TIMEOUT_MS)
-                # Empty means "not ready"; a full 0x200 is a known USB 3 host quirk: poll again.
                 if 0 < len(reply) < P.CMD_REPLY_LENGTH:
                     break
+                if len(reply) == P.CMD_REPLY_LENGTH:
+                    # libfreenect polls again on a full 0x200 (a USB 3 host quirk), which never ends on hosts
+                    # that always fill the buffer: take the reply its header announces when it answers us
+                    full = True
+                    trimmed = padded_reply(bytes(reply), opcode, tag)
+                    if trimmed is not None:
+                        self.padded_replies += 1
+                        reply = trimmed
+                        break
                 if time.monotonic() > deadline:
-                    raise ProtocolError(f"no reply to camera command {opcode:#x} within {REPLY_TIMEOUT_S} s")
+                    raise ProtocolError(full_reply_advice(opcode) if full else
+                                        f"no reply to camera command {opcode:#x} within {REPLY_TIMEOUT_S} s")
                 time.sleep(0.001)
         except usb.core.USBError as exc:
-            if is_gone(exc):
-                raise DeviceGone("the Kinect was unplugged") from exc
-            raise ProtocolError(f"camera command {opcode:#x} failed: {exc}") from exc
+            raise usb_failure(exc, f"camera command {opcode:#x}", ProtocolError) from exc
         payload_back = P.parse_reply(bytes(reply), opcode, tag)
         self._tag = (tag + 1) & 0xFFFF
         return payload_back
@@ -129,7 +198,10 @@ class KinectCamera:
     def write_register(self, reg: int, value: int) -> None:
         payload = self.command(P.OP_WRITE_REGISTER, P.words(reg, value))
         if payload != b"\x00\x00":
-            raise ProtocolError(f"register {reg:#x} write was not acknowledged (reply {payload.hex()})")
+            # libfreenect only warns: real devices have answered 4 bytes (its issue #598) and work
+            self.odd_write_acks.append((reg, payload.hex()))
+            log.warning("register %#x write answered %s instead of 0000; going on, as libfreenect does",
+                        reg, payload.hex() or "nothing")
 
     def read_calibration(self) -> Calibration:
         fixed = self.command(P.OP_FIXED_PARAMS, P.words(0, 0, 0, 0, 0))

@@ -6,6 +6,8 @@ route the same functions through the audio chip as bulk commands, which only exi
 """
 from __future__ import annotations
 
+import itertools
+import logging
 import struct
 from dataclasses import dataclass
 
@@ -17,6 +19,8 @@ from . import protocol as P
 from .kinect_camera import access_advice, is_gone
 from .discovery import KinectInfo, find_kinect
 from .errors import AccessDenied, DeviceGone, MotorUnavailable, ProtocolError
+
+log = logging.getLogger(__name__)
 
 TILT_LIMIT_DEG = 27.0
 COUNTS_PER_G = 819.0
@@ -40,6 +44,65 @@ def clamp_tilt(angle: float) -> float:
     return float(min(TILT_LIMIT_DEG, max(-TILT_LIMIT_DEG, angle)))
 
 
+def _usb_io(fn, *args, role: str = "motor"):
+    try:
+        return fn(*args)
+    except usb.core.USBError as exc:
+        if is_gone(exc):
+            raise DeviceGone("the Kinect was unplugged") from exc
+        raise AccessDenied(f"cannot use the Kinect {role}: {access_advice(exc, role)}") from exc
+    except NotImplementedError as exc:
+        raise AccessDenied(f"cannot use the Kinect {role}: {access_advice(exc, role)}") from exc
+
+
+def audio_command(device, tag: int, cmd: int, arg1: int = 0, arg2: int | None = None, data_len: int = 0) -> bytes:
+    """One bulk command to the audio chip (models 1473 / Kinect for Windows): {magic, tag, arg1, cmd[, arg2]}
+    on endpoint 0x01, an optional data reply, then the 12-byte status {0x0A6FE000, tag, 0} on 0x81."""
+    fields = [ALT_MAGIC, tag, arg1, cmd] + ([] if arg2 is None else [arg2 & 0xFFFFFFFF])
+    _usb_io(device.write, 0x01, struct.pack(f"<{len(fields)}I", *fields), 250, role="audio")
+    data = bytes(_usb_io(device.read, 0x81, 512, 250, role="audio")) if data_len else b""
+    reply = bytes(_usb_io(device.read, 0x81, 512, 250, role="audio"))
+    if len(reply) != 12:
+        raise ProtocolError(f"audio chip reply has {len(reply)} bytes, expected 12")
+    magic, _tag, status = struct.unpack("<3I", reply)
+    if magic != ALT_REPLY_MAGIC or status != 0:
+        raise ProtocolError(f"audio chip command {cmd:#x} failed (magic {magic:#x}, status {status})")
+    return data
+
+
+_keep_alive_tags = itertools.count()
+
+
+def send_keep_alive(audio) -> str:
+    """libfreenect's keep-alive for every Kinect that is not a 1414: reset the audio chip (a previous session
+    may have left it mid-command), then set its LED green. Without it newer 1473s (and Xbox-updated 1414s,
+    which no longer report themselves as 1414) re-enumerate every few seconds. It needs no audio firmware.
+    Returns '' when sent, else what went wrong: a warning, since the depth stream may still work."""
+    if audio is None:
+        return "LED keep-alive not sent: the Kinect's audio device was not found"
+    try:
+        try:
+            audio.reset()
+        except (usb.core.USBError, NotImplementedError) as exc:
+            if is_gone(exc):
+                raise DeviceGone("the Kinect was unplugged") from exc
+            log.info("audio chip reset before the keep-alive failed (%s); sending it anyway", exc)
+        usb.util.dispose_resources(audio)
+        _usb_io(usb.util.claim_interface, audio, 0, role="audio")
+        try:
+            audio_command(audio, next(_keep_alive_tags), ALT_CMD_LED, 0, _ALT_LED[LED_MODES["green"]])
+        finally:
+            try:
+                usb.util.release_interface(audio, 0)
+            except (usb.core.USBError, NotImplementedError):
+                pass
+        return ""
+    except (AccessDenied, ProtocolError) as exc:
+        return f"LED keep-alive not sent ({exc}); the Kinect may drop off the bus every few seconds"
+    finally:
+        usb.util.dispose_resources(audio)
+
+
 class KinectMotor:
     """Motor functions of one Kinect (from discovery)."""
 
@@ -52,28 +115,11 @@ class KinectMotor:
         self._tag = 0
 
     def _io(self, fn, *args):
-        try:
-            return fn(*args)
-        except usb.core.USBError as exc:
-            if is_gone(exc):
-                raise DeviceGone("the Kinect was unplugged") from exc
-            raise AccessDenied(f"cannot use the Kinect motor: {access_advice(exc)}") from exc
-        except NotImplementedError as exc:
-            raise AccessDenied(f"cannot use the Kinect motor: {access_advice(exc)}") from exc
+        return _usb_io(fn, *args)
 
-    # --- audio-chip command channel (1473 / Kinect for Windows) ----------------------------------------------
     def _alt_command(self, cmd: int, arg1: int = 0, arg2: int | None = None, data_len: int = 0) -> bytes:
-        fields = [ALT_MAGIC, self._tag, arg1, cmd] + ([] if arg2 is None else [arg2 & 0xFFFFFFFF])
         self._tag += 1
-        self._io(self.device.write, 0x01, struct.pack(f"<{len(fields)}I", *fields), 250)
-        data = bytes(self._io(self.device.read, 0x81, 512, 250)) if data_len else b""
-        reply = bytes(self._io(self.device.read, 0x81, 512, 250))
-        if len(reply) != 12:
-            raise ProtocolError(f"motor reply has {len(reply)} bytes, expected 12")
-        magic, _tag, status = struct.unpack("<3I", reply)
-        if magic != ALT_REPLY_MAGIC or status != 0:
-            raise ProtocolError(f"motor command {cmd:#x} failed (magic {magic:#x}, status {status})")
-        return data
+        return audio_command(self.device, self._tag - 1, cmd, arg1, arg2, data_len)
 
     # --- public --------------------------------------------------------------------------------------------
     def set_tilt(self, angle: float) -> float:

@@ -18,9 +18,11 @@ PID_MOTOR = 0x02B0            # model 1414 only
 PID_MOTOR_K4W = 0x02C2
 PID_AUDIO = 0x02AD
 PID_AUDIO_K4W = 0x02BE
+PID_AUDIO_K4W_SDK = 0x02C3    # Kinect for Windows audio once the SDK's firmware runs on it
+PID_AUDIO_K4W_BETA = 0x02BB   # ... once the beta SDK's firmware runs on it
 CAMERA_PIDS = (PID_CAMERA, PID_CAMERA_K4W)
 MOTOR_PIDS = (PID_MOTOR, PID_MOTOR_K4W)
-AUDIO_PIDS = (PID_AUDIO, PID_AUDIO_K4W)
+AUDIO_PIDS = (PID_AUDIO, PID_AUDIO_K4W, PID_AUDIO_K4W_SDK, PID_AUDIO_K4W_BETA)
 BCD_MODEL_1414 = 267          # the 1414 camera reports bcdDevice 0x010B
 
 CAMERA_INTERFACE = 0

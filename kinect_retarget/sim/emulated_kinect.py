@@ -25,16 +25,16 @@ from ..device.depth_unpack import pack_11bit
 from .emulated_motor import EmulatedMotor, Rejected
 from .emulated_libusb import EmulatedLibusb
 from .emulated_stream import DepthPacketizer, FaultyWire, Faults, VirtualClock
-from .emulated_usb import UsbFunction, build_functions
+from .emulated_usb import UsbFunction, build_functions, calibration_reply
 from ..device.protocol import TICKS_PER_FRAME
 from ..device.usb_backend import LIBUSB_ERROR_NO_DEVICE
 
 LIBUSB_ERROR_PIPE = -9
 LIBUSB_ERROR_ACCESS = -3
 LIBUSB_ERROR_TIMEOUT = -7
+LIBUSB_ERROR_IO = -1
 DEFAULT_SERIAL = "A00366A08793039A"
-CONST_SHIFT = 200
-FIXED_PARAMS = (7.5, 2.4, 120.0, 0.1052)       # emitter dist (cm), rcmos dist (cm), ref dist (mm), pixel (mm)
+REENUMERATE_S = 2.0     # a 1473 without the LED keep-alive drops off the bus this long after its camera opens
 
 
 _handle_ids = itertools.count(1)
@@ -73,12 +73,17 @@ class EmulatedKinect(usb.backend.IBackend):
     """
 
     def __init__(self, images, model: str = "1414", serial: str = DEFAULT_SERIAL, faults: Faults | None = None,
-                 clock=None, sleep=None, bus: int = 1, audio_firmware: bool = False):
+                 clock=None, sleep=None, bus: int = 1, audio_firmware: bool = False,
+                 needs_keep_alive: bool | None = None, topology: str = "hub"):
         super().__init__()
         self.images = [np.asarray(img, dtype=np.uint16) for img in images]
         if not self.images:
             raise ValueError("the emulated Kinect needs at least one depth image")
         self.model = model
+        # newer 1473s (and Xbox-updated 1414s, which report themselves as such) re-enumerate every few
+        # seconds unless the audio chip is sent an LED command after power-on (libfreenect issue #452)
+        self.needs_keep_alive = model == "1473" if needs_keep_alive is None else needs_keep_alive
+        self.reenumerations = 0
         self._packed = [pack_11bit(img) for img in self.images]   # once: the wire format of each image
         self.faults = faults or Faults()
         if isinstance(clock, VirtualClock) and sleep is None:
@@ -92,7 +97,7 @@ class EmulatedKinect(usb.backend.IBackend):
         self._stream_ids = itertools.count(1)
         self._first_start: float | None = None
         self._manual_plugged = True
-        self.functions = build_functions(model, serial, audio_firmware)
+        self.functions = build_functions(model, serial, audio_firmware, topology)
         self._bulk_replies: list[bytes] = []
         self._assign_addresses()
         self._power_on()
@@ -126,6 +131,8 @@ class EmulatedKinect(usb.backend.IBackend):
         self._pending_reply: bytes | None = None
         self._reply_delay = 0
         self.motor = EmulatedMotor(self.clock)
+        self.keep_alive_received = False
+        self._camera_opened_at: float | None = None
 
     # --- plug state --------------------------------------------------------------------------------------
     def _scheduled_plugged(self) -> bool:
@@ -152,6 +159,13 @@ class EmulatedKinect(usb.backend.IBackend):
     def _update_plug(self) -> None:
         """Apply a plug change: unplugging invalidates every handle and resets the device on power-up."""
         plugged = self.plugged
+        opened = self._camera_opened_at
+        if (plugged and self._generation >= 0 and self.needs_keep_alive and not self.keep_alive_received
+                and opened is not None and self.clock() - opened >= REENUMERATE_S):
+            self._generation += 1                            # gone and back at once, as a fresh device
+            self.reenumerations += 1
+            self._assign_addresses()
+            self._power_on()
         if not plugged and self._generation >= 0:
             self._generation = -(self._generation + 1)       # negative: unplugged
         elif plugged and self._generation < 0:
@@ -168,8 +182,8 @@ class EmulatedKinect(usb.backend.IBackend):
     def handle_by_id(self, handle_id) -> _Handle | None:
         return self._handles.get(handle_id)
 
-    def handle_alive(self, handle: _Handle) -> bool:
-        return self.refresh_plug() and handle.generation == self._generation
+    def handle_alive(self, handle: _Handle | None) -> bool:
+        return handle is not None and self.refresh_plug() and handle.generation == self._generation
 
     def wire_packet(self, stream: "_DepthStreamState", index: int) -> bytes | None:
         """Packet `index` of a depth stream as it reaches the host: None if the wire lost it."""
@@ -236,6 +250,8 @@ class EmulatedKinect(usb.backend.IBackend):
     def claim_interface(self, dev_handle, intf):
         self.check_handle(dev_handle)
         dev_handle.claimed.add(intf)
+        if dev_handle.function.kind == "camera" and self._camera_opened_at is None:
+            self._camera_opened_at = self.clock()
 
     def release_interface(self, dev_handle, intf):
         dev_handle.claimed.discard(intf)
@@ -285,15 +301,18 @@ class EmulatedKinect(usb.backend.IBackend):
         raise USBError("No such device (it may have been disconnected)", LIBUSB_ERROR_NO_DEVICE, errno.ENODEV)
 
     def _camera_control(self, rtype, request, value, index, data) -> int:
+        if self.faults.command_eio:        # a failing cable or hub: the device stays on the bus
+            raise USBError("Input/Output Error", LIBUSB_ERROR_IO, errno.EIO)
         if rtype == P.CMD_REQUEST_OUT and request == 0 and value == 0 and index == 0:
             self._camera_command(bytes(data))
             return len(data)
         if rtype == P.CMD_REQUEST_IN and request == 0 and value == 0 and index == 0:
+            pad = self.faults.reply_padding    # Windows hosts that always return the full 0x200
             if self._pending_reply is None or self._reply_delay > 0:
                 self._reply_delay -= 1
-                return 0                       # not ready yet: the host polls again
+                return self._fill(data, bytes(P.CMD_REPLY_LENGTH)) if pad else 0   # not ready: poll again
             reply, self._pending_reply = self._pending_reply, None
-            return self._fill(data, reply)
+            return self._fill(data, reply.ljust(P.CMD_REPLY_LENGTH, b"\0") if pad else reply)
         self._stall()
 
     def _camera_command(self, message: bytes) -> None:
@@ -316,21 +335,8 @@ class EmulatedKinect(usb.backend.IBackend):
             return P.words(args[0], self.registers.get(args[0], 0))
         if opcode == P.OP_WRITE_REGISTER and len(args) == 2:
             self._write_register(*args)
-            return P.words(0)
-        if opcode == P.OP_FIXED_PARAMS and len(args) == 5:
-            size = 322 if self.model == "1414" else 334
-            body = bytearray(size)
-            struct.pack_into("<4f", body, 94, *FIXED_PARAMS)
-            return bytes(body)
-        if opcode == P.OP_ALGORITHM_PARAMS and len(args) == 5:
-            sizes = {P.ALGO_CONST_SHIFT: 4, 0x40: 118, 0x41: 8}
-            if args[0] not in sizes:
-                return None
-            body = bytearray(sizes[args[0]])
-            if args[0] == P.ALGO_CONST_SHIFT:
-                struct.pack_into("<H", body, 2, CONST_SHIFT)
-            return bytes(body)
-        return None
+            return bytes(self.faults.write_ack_bytes)      # 0000, or 00000000 as some devices answer
+        return calibration_reply(opcode, args, self.model)
 
     def _write_register(self, reg: int, value: int) -> None:
         self.registers[reg] = value
@@ -364,10 +370,13 @@ class EmulatedKinect(usb.backend.IBackend):
         with self._lock:
             self.check_handle(dev_handle)
             fn = dev_handle.function
-            if fn.kind != "audio" or len(fn.interfaces) < 2 or ep != 0x01:
+            if fn.kind != "audio" or ep != 0x01:
                 self._stall()
             try:
-                self._bulk_replies += self.motor.audio_command(bytes(data))
+                # the bootloader (no firmware) takes the LED command only: libfreenect's keep-alive
+                replies = self.motor.audio_command(bytes(data), firmware=len(fn.interfaces) >= 2)
+                self.keep_alive_received = True
+                self._bulk_replies += replies
             except Rejected:
                 self._stall()
             return len(data)

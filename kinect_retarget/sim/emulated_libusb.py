@@ -21,8 +21,10 @@ import usb.backend.libusb1 as L
 
 from .emulated_stream import MICROFRAME_S, packet_microframe
 from ..device.protocol import DEPTH_PACKETS_PER_FRAME, MAX_ISO_PACKET_SIZE
-from ..device.usb_backend import (CANCELLED, COMPLETED, LIBUSB_ERROR_IO, LIBUSB_ERROR_NO_DEVICE, LIBUSB_ERROR_NOT_FOUND,
-                          NO_DEVICE)
+
+# libusb's own constants (libusb.h): the emulated libusb states them itself rather than trusting the driver's
+COMPLETED, TRANSFER_ERROR, CANCELLED, NO_DEVICE = 0, 1, 3, 5
+LIBUSB_ERROR_IO, LIBUSB_ERROR_NO_DEVICE, LIBUSB_ERROR_NOT_FOUND = -1, -4, -5
 
 _T, _D = L._libusb_transfer, L._libusb_iso_packet_descriptor
 
@@ -135,7 +137,7 @@ class EmulatedLibusb:
         """Transfers that come back now, their status and packets filled in."""
         dev = self._dev
         with dev._lock:
-            alive = dev.refresh_plug()
+            dev.refresh_plug()
             done = []
             delay = dev.faults.cancel_delay_s
             for armed in list(self._armed):
@@ -143,12 +145,13 @@ class EmulatedLibusb:
                     self._armed.remove(armed)
                     armed.pointer.contents.status = CANCELLED
                     done.append(armed)
-            if not alive:              # unplugged: everything comes back at once
+            gone = [a for a in self._armed if not dev.handle_alive(dev.handle_by_id(a.pointer.contents.dev_handle))]
+            if gone:                   # unplugged or re-enumerated: its transfers come back at once
                 status = CANCELLED if dev.faults.unplug_cancels else NO_DEVICE
-                while self._armed:
-                    armed = self._armed.popleft()
+                for armed in gone:
+                    self._armed.remove(armed)
                     armed.pointer.contents.status = status
-                    done.append(armed)
+                done += gone
                 return done
             now = microframe(dev.clock())
             while self._armed and self._armed[0].end <= now and self._armed[0].cancelled_at is None:
@@ -164,7 +167,7 @@ class EmulatedLibusb:
         for desc in descs:
             desc.status, desc.actual_length = COMPLETED, 0
         stream = self._dev.depth_stream
-        if stream is None:
+        if stream is None or self._dev.faults.no_data:
             return
         if stream.id != self._stream_id:
             self._stream_id, self._next = stream.id, 0
@@ -184,7 +187,7 @@ class EmulatedLibusb:
             packet = self._dev.wire_packet(stream, i)
             if packet is None:
                 self.faulted[key] = self.faulted.get(key, 0) + 1
-                slot.status = 1                      # LIBUSB_TRANSFER_ERROR for this packet
+                slot.status = TRANSFER_ERROR
                 continue
             if len(packet) < stream.packetizer.packet_length(i):
                 self.faulted[key] = self.faulted.get(key, 0) + 1

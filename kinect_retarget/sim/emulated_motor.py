@@ -59,11 +59,14 @@ class EmulatedMotor:
             return b"\x22"
         raise Rejected
 
-    def audio_command(self, data: bytes) -> list[bytes]:
-        """A bulk command to the audio chip (firmware running): the replies it queues on endpoint 0x81."""
+    def audio_command(self, data: bytes, firmware: bool = True) -> list[bytes]:
+        """A bulk command to the audio chip: the replies it queues on endpoint 0x81. Without its firmware
+        (bootloader) it only takes the LED command."""
         if len(data) < 16:
             raise Rejected
         magic, tag, _arg1, cmd = struct.unpack_from("<4I", data)
+        if not firmware and cmd != ALT_CMD_LED:
+            raise Rejected
         arg2 = struct.unpack_from("<i", data, 16)[0] if len(data) >= 20 else 0
         self._advance()
         replies, status = [], 0

@@ -37,6 +37,7 @@ class Faults:
     write_ack_bytes: int = 2                   # register writes answered with 2 bytes (0000) or 4 (00000000)
     reply_padding: bool = False                # every control IN returns 0x200 bytes (Windows, issue #494)
     command_eio: bool = False                  # camera control transfers fail with EIO (device still there)
+    no_data: bool = False                      # the depth stream starts but no packet ever arrives
 
 
 class DepthPacketizer:
