@@ -45,7 +45,8 @@ def generated(bpy, path):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     take = load_take(path)
     obj = new_generated_rig(bpy.context.scene, take)
-    res = bake_take(obj, take, preset="kinect", settings=RetargetSettings(filter="none"))
+    res = bake_take(obj, take, preset="kinect",
+                   settings=RetargetSettings(filter="none", fps=take.rate))  # keys on the take's samples
     m = res.motion
     heads, tails, names = posed_heads_tails(bpy, obj, m.frames)
     sk = take.skeleton
@@ -75,7 +76,8 @@ def rigify(bpy, rig_path, path, frames=90):
     obj = bpy.data.objects["rig"]
     take = load_take(path)
     take = take.slice(slice(0, min(frames, take.frame_count)))
-    res = bake_take(obj, take, preset="rigify", settings=RetargetSettings(filter="none"))
+    res = bake_take(obj, take, preset="rigify",
+                   settings=RetargetSettings(filter="none", fps=take.rate))  # keys on the take's samples
     heads, tails, names = posed_heads_tails(bpy, obj, res.motion.frames)
     sk = take.skeleton
     src = kinect_to_blender(take.positions[res.motion.samples])

@@ -2,19 +2,23 @@
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
 
 import bpy
 import numpy as np
 from bpy.utils import escape_identifier
 
+from ..core.bake_options import BakeOptions, take_range
+from ..core.key_reduction import Reduction, reduce_keys
 from ..core.kinect_rig_layout import median_segment_lengths
 from ..core.pipeline import BakedMotion, RetargetPipeline, RetargetSettings
 from ..core.presets import build_mapping, mapping_problems
+from ..core.resample import resample_motion
+from ..core.rotation_modes import channel_values
 from ..core.skeletons import Skeleton
 from ..core.take import Take
-from .io.action_writer import bake_motion
+from .io.action_writer import bake_motion, push_to_nla
 from .io.evaluated_solve import correct_for_evaluation
 from .io.kinect_rig import build_kinect_rig
 from .io.pose_apply import restore_pose, snapshot_pose
@@ -29,6 +33,8 @@ class BakeResult:
     motion: BakedMotion
     preset: str
     frame_range: tuple[int, int]
+    reduction: Reduction | None = None
+    strip: str | None = None
 
 
 def _no_report(level: set, message: str) -> None:
@@ -54,22 +60,67 @@ def make_pipeline(obj: bpy.types.Object, skeleton: Skeleton, preset: str = "auto
     return RetargetPipeline(skeleton, rig, mapping, settings), used
 
 
+def scene_rate(scene: bpy.types.Scene) -> float:
+    return scene.render.fps / scene.render.fps_base
+
+
+def _reduce(obj, motion: BakedMotion, options: BakeOptions) -> Reduction | None:
+    if not options.reduce:
+        return None
+    pose_bones = obj.pose.bones
+    rotations = []
+    for k, bone in enumerate(motion.bone_names):
+        mode = pose_bones[bone].rotation_mode
+        rotations.append((channel_values(motion.quats[:, k], mode)[1], mode))
+    location = motion.root_location if motion.root_bone is not None else None
+    return reduce_keys(motion.frames, rotations, location, options.tolerance_deg, options.tolerance_mm)
+
+
+def _update_scene(scene: bpy.types.Scene, rate: float, first: int, last: int, options: BakeOptions) -> str:
+    """Apply the scene options; a sentence saying what the scene is now (and when keys run past its range)."""
+    changed = []
+    if options.set_scene_fps and abs(scene_rate(scene) - rate) > 1e-6:
+        set_scene_rate(scene, rate)
+        changed.append("frame rate")
+    if options.extend_scene_range and (first < scene.frame_start or last > scene.frame_end):
+        # never shortens: only the ends the keys pass move
+        scene.frame_start, scene.frame_end = min(scene.frame_start, first), max(scene.frame_end, last)
+        changed.append("range")
+    now = f"{scene_rate(scene):g} fps, frames {scene.frame_start}-{scene.frame_end}"
+    if changed:
+        return f"scene {' and '.join(changed)} set: {now}"
+    outside = first < scene.frame_start or last > scene.frame_end
+    return f"scene unchanged ({now}" + ("; keys run outside it: Extend Scene Range grows it)" if outside else ")")
+
+
 def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
               overrides: dict[str, str] | None = None, settings: RetargetSettings | None = None,
-              action_name: str | None = None, set_scene_range: bool = True,
+              action_name: str | None = None, options: BakeOptions | None = None,
               report: Report = _no_report, progress: Callable[[float], None] | None = None) -> BakeResult:
-    """Retarget `take` onto armature `obj` and key it into a new Action assigned to `obj`.
+    """Retarget `take` onto armature `obj` and key it into a new Action assigned to `obj` (or as `options`
+    say: part of the take, key step, key reduction, the current Action, an NLA strip).
 
+    Keys follow the scene's frame rate (settings.fps when given; the take's own with Set Scene Frame Rate),
+    resampled from the take's samples; the scene's rate and range change only when the options ask.
     Only pose channels are keyed; the rig's bones, rolls, constraints and settings are left as they are.
-    Raises ValueError (wrong armature, no mapped bone) before anything in the scene changes.
+    Raises ValueError (wrong armature, no mapped bone, empty range) before anything in the scene changes.
     """
     settings = settings or RetargetSettings()
-    pipeline, used = make_pipeline(obj, take.skeleton, preset, overrides, settings)
+    options = options or BakeOptions()
+    scene = bpy.context.scene
+    whole = take
+    take, part = take_range(take, options)
+    rate = float(settings.fps or (take.rate if options.set_scene_fps else scene_rate(scene)))
+    # solve at the take's own samples, then key on the scene's frame grid
+    pipeline, used = make_pipeline(obj, take.skeleton, preset, overrides, replace(settings, fps=None))
     for problem in mapping_problems(pipeline.rig.bone_names, overrides):
         report({"WARNING"}, problem)
     for warning in take.metadata.get("warnings", ()):  # what the reader dropped (bad samples, a cut-off line)
         report({"WARNING"}, warning)
     motion = pipeline.process_take(take)
+    if abs(rate - take.rate) > 1e-6 or options.step > 1:  # at the take's own rate each sample keys its frame
+        motion = resample_motion(motion, take.times[motion.samples] - take.times[0], rate, settings.frame_start,
+                                 options.step)
     if progress:
         progress(0.3)
     extra = []
@@ -89,21 +140,26 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
             restore_pose(obj, saved_pose)
             for name, value in saved.items():
                 obj.pose.bones[name]["IK_FK"] = value
-    name = action_name or f"{obj.name}_{take.metadata.get('name', 'take')}"
-    action = bake_motion(obj, motion, name, extra)
+    take_name = whole.metadata.get("name", "take")
+    name = action_name or f"{obj.name}_{take_name}"
+    reduction = _reduce(obj, motion, options)
+    action = bake_motion(obj, motion, name, extra, keys=reduction, into_current=options.into_current)
     first, last = int(motion.frames[0]), int(motion.frames[-1])
-    if set_scene_range:
-        scene = bpy.context.scene
-        set_scene_rate(scene, motion.fps)
-        scene.frame_start, scene.frame_end = first, last
+    strip = push_to_nla(obj, take_name, first).name if options.push_nla else None
+    scene_note = _update_scene(scene, rate, first, last, options)
     skipped = motion.extras.get("skipped_bones", ())
-    report({"INFO"}, f"Baked {len(motion.frames)} frames ({len(motion.bone_names)} bones, preset {used}) "
-                     f"onto {obj.name!r} as action {action.name!r}"
+    every = f", every {options.step} frames" if options.step > 1 else ""
+    report({"INFO"}, f"Baked {len(motion.frames)} keys at frames {first}-{last} ({rate:g} fps{every}; "
+                     f"{part or 'whole take'}, {whole.rate:g} fps) for {len(motion.bone_names)} bones "
+                     f"(preset {used}) onto {obj.name!r} as action {action.name!r}"
+                     + (f", NLA strip {strip!r}" if strip else "") + f"; {scene_note}"
+                     + (f"; key reduction removed {reduction.removed} keys (max error {reduction.max_deg:.3f}°, "
+                        f"{reduction.max_mm:.3f} mm)" if reduction else "")
                      + (f"; left alone (the take has no position for their joints): {', '.join(skipped)}"
                         if skipped else ""))
     if progress:
         progress(1.0)
-    return BakeResult(action, motion, used, (first, last))
+    return BakeResult(action, motion, used, (first, last), reduction, strip)
 
 
 def take_display_name(path: str) -> str:

@@ -3,9 +3,11 @@ from __future__ import annotations
 
 import os
 import sys
+from dataclasses import replace
 
 import bpy
 
+from ..core.bake_options import BakeOptions
 from ..core.pipeline import RetargetSettings
 from ..core.take import Take
 from .bake_take import bake_take, new_generated_rig
@@ -64,19 +66,38 @@ def open_target(rig_path: str | None, armature: str | None, preset: str, generat
 
 def bake_to_file(take: Take, out_path: str, *, rig_path: str | None = None, armature: str | None = None,
                  preset: str = "auto", overrides: dict | None = None,
-                 settings: RetargetSettings | None = None) -> dict:
-    """Bake onto the armature of rig_path (or a generated Kinect rig) and save out_path. Returns a summary."""
+                 settings: RetargetSettings | None = None, options: BakeOptions | None = None) -> dict:
+    """Bake onto the armature of rig_path (or a generated Kinect rig) and save out_path (.blend, or exported
+    as .fbx, .glb/.gltf or .bvh). Returns a summary. The rig file's scene keeps its rate and range unless
+    `options` ask; a generated rig's new scene runs at the bake's rate over exactly the baked frames."""
+    from .io.rig_export import check_export_path, export_rig
+    kind = check_export_path(out_path)  # a wrong extension fails before anything is opened
+    options = options or BakeOptions()
     messages: list[str] = []
     obj, preset = open_target(rig_path, armature, preset, lambda scene: new_generated_rig(scene, take))
+    if rig_path is None:  # our own new scene: it runs at the bake's rate over exactly the baked frames
+        options = replace(options, set_scene_fps=True, extend_scene_range=True)
+        scene = bpy.context.scene
+        scene.frame_start = scene.frame_end = (settings or RetargetSettings()).frame_start
     bpy.context.view_layer.objects.active = obj
     def report(level, msg):
         messages.append(msg)
         if "WARNING" in level:
             print(f"warning: {msg}", file=sys.stderr)
-    result = bake_take(obj, take, preset=preset, overrides=overrides, settings=settings, report=report)
-    save_blend(out_path)
-    return {"out": out_path, "armature": obj.name, "preset": result.preset, "action": result.action.name,
-            "frames": len(result.motion.frames), "frame_range": list(result.frame_range),
-            "bones": len(result.motion.bone_names),
-            "dropped_joint_samples": int(take.metadata.get("dropped_joint_samples", 0)),
-            "message": messages[-1] if messages else ""}
+    result = bake_take(obj, take, preset=preset, overrides=overrides, settings=settings, options=options,
+                       report=report)
+    if kind == "blend":
+        save_blend(out_path)
+    else:
+        export_rig(obj, out_path, result.frame_range)
+    summary = {"out": out_path, "armature": obj.name, "preset": result.preset, "action": result.action.name,
+               "frames": len(result.motion.frames), "frame_range": list(result.frame_range),
+               "bones": len(result.motion.bone_names),
+               "dropped_joint_samples": int(take.metadata.get("dropped_joint_samples", 0)),
+               "message": messages[-1] if messages else ""}
+    if result.reduction is not None:
+        summary.update(keys_removed=result.reduction.removed, max_error_deg=round(result.reduction.max_deg, 4),
+                       max_error_mm=round(result.reduction.max_mm, 4))
+    if result.strip:
+        summary["nla_strip"] = result.strip
+    return summary

@@ -6,6 +6,7 @@ import os
 
 import numpy as np
 
+from ..core.bake_options import RANGE_UNITS, BakeOptions
 from ..core.filters import FILTERS
 from ..core.presets import PRESET_NAMES
 from ..core.retarget import ROOT_MODES
@@ -18,19 +19,48 @@ def add_parsers(sub) -> None:
     p.add_argument("--json", action="store_true", help="one JSON object instead of text")
     p.set_defaults(handler=run_info)
 
-    p = sub.add_parser("bake", help="bake a take onto a rig and save a .blend")
+    p = sub.add_parser("bake", help="bake a take onto a rig and save a .blend, or export .fbx/.glb/.bvh")
     p.add_argument("take")
-    p.add_argument("--out", required=True, help="output .blend")
+    p.add_argument("--out", required=True,
+                   help="output .blend, or .fbx / .glb / .gltf / .bvh exported with game-engine settings")
     p.add_argument("--rig", help=".blend holding the target armature (default: a generated Kinect rig)")
     p.add_argument("--armature", help="armature object name in --rig (default: the only armature)")
     p.add_argument("--preset", choices=PRESET_NAMES, default="auto")
     p.add_argument("--mapping", help="JSON {bone: joint} overriding the preset per bone")
     p.add_argument("--filter", choices=FILTERS, default="default")
     p.add_argument("--root", choices=ROOT_MODES, default="xyz")
-    p.add_argument("--fps", type=float, help="scene rate (default: the take's nominal rate)")
-    p.add_argument("--frame-start", type=int, default=1)
+    p.add_argument("--fps", type=float, help="key rate (default: the rig file's scene rate; the take's own "
+                                            "rate in the new scene made without --rig)")
+    p.add_argument("--frame-start", type=int, default=1, help="scene frame of the take's (range's) start")
     p.add_argument("--mirror", action="store_true", help="swap the performer's left and right")
+    add_bake_option_args(p)
     p.set_defaults(handler=run_bake)
+
+
+def add_bake_option_args(p) -> None:
+    g = p.add_argument_group("bake options (see docs/bake.md)")
+    g.add_argument("--take-start", type=float, help="bake from here in the take (--range-unit; default: start)")
+    g.add_argument("--take-end", type=float, help="bake up to here in the take, inclusive (default: end)")
+    g.add_argument("--range-unit", choices=RANGE_UNITS, default="seconds",
+                   help="unit of --take-start/--take-end: seconds from the take's start or take frames from 0")
+    g.add_argument("--step", type=int, default=1, help="key every N scene frames")
+    g.add_argument("--reduce", action="store_true", help="remove keys linear interpolation reproduces within "
+                                                         "--tolerance-deg / --tolerance-mm")
+    g.add_argument("--tolerance-deg", type=float, default=0.5, help="key reduction: rotation tolerance, degrees")
+    g.add_argument("--tolerance-mm", type=float, default=1.0, help="key reduction: root tolerance, millimetres")
+    g.add_argument("--into-current", action="store_true",
+                   help="key into the rig's current Action (its keys in the baked range are replaced)")
+    g.add_argument("--nla", action="store_true", help="push the new Action to the NLA as a strip named after the take")
+    g.add_argument("--set-scene-fps", action="store_true", help="set the rig file's scene to the key rate")
+    g.add_argument("--extend-range", action="store_true",
+                   help="grow the rig file's scene range to hold the keys (never shortens it)")
+
+
+def bake_options_from_args(args) -> BakeOptions:
+    return BakeOptions(range_start=args.take_start, range_end=args.take_end, range_unit=args.range_unit,
+                       step=args.step, reduce=args.reduce, tolerance_deg=args.tolerance_deg,
+                       tolerance_mm=args.tolerance_mm, into_current=args.into_current, push_nla=args.nla,
+                       set_scene_fps=args.set_scene_fps, extend_scene_range=args.extend_range)
 
 
 def take_summary(path: str) -> dict:
@@ -72,10 +102,11 @@ def run_bake(args) -> int:
     take.metadata.setdefault("name", os.path.splitext(os.path.basename(args.take))[0])
     settings = RetargetSettings(filter=args.filter, root_mode=args.root, fps=args.fps,
                                 frame_start=args.frame_start, mirror=args.mirror)
+    options = bake_options_from_args(args)  # bad options fail here too
     overrides = load_mapping_file(args.mapping) if args.mapping else None
     from ..blender.headless import bake_to_file
 
     result = bake_to_file(take, args.out, rig_path=args.rig, armature=args.armature, preset=args.preset,
-                          overrides=overrides, settings=settings)
+                          overrides=overrides, settings=settings, options=options)
     print(json.dumps(result))
     return 0

@@ -37,7 +37,8 @@ def test_generated_rig_round_trip(bpy_empty, shared_data, take_path):
     if take.frame_count > 300:
         take = take.slice(slice(0, 300))
     obj = new_generated_rig(bpy.context.scene, take)
-    res = bake_take(obj, take, preset="kinect", settings=RetargetSettings(filter="none"))
+    res = bake_take(obj, take, preset="kinect",
+                   settings=RetargetSettings(filter="none", fps=take.rate))  # keys on the take's samples
     sk = take.skeleton
     pairs = {j: (sk.joints[sk.parents[i]], j) for i, j in enumerate(sk.joints) if sk.parents[i] >= 0}
     errs = _check_directions(bpy, obj, res.motion, take, pairs)
@@ -79,7 +80,8 @@ def test_rigify_generated_rig_limbs_follow(shared_data, rigify_rig_path):
     bpy.ops.wm.open_mainfile(filepath=str(rigify_rig_path))
     obj = bpy.data.objects["rig"]
     take = load_take(shared_data / "kinect_v2" / "Ges01_wavehand.csv").slice(slice(0, 40))
-    res = bake_take(obj, take, preset="auto", settings=RetargetSettings(filter="none"))
+    res = bake_take(obj, take, preset="auto",
+                   settings=RetargetSettings(filter="none", fps=take.rate))  # keys on the take's samples
     assert res.preset == "rigify"
     pairs = {f"DEF-{b}.{s[0]}": (f"{a}{s}", f"{c}{s}") for s in ("Left", "Right") for b, a, c in
              (("upper_arm", "Shoulder", "Elbow"), ("forearm", "Elbow", "Wrist"), ("thigh", "Hip", "Knee"),
@@ -158,7 +160,8 @@ def test_rigify_metarig_preset(bpy_empty, shared_data):
     bpy.ops.object.armature_human_metarig_add()
     obj = bpy.context.object
     take = load_take(shared_data / "mocap_bvh" / "01_01.bvh").slice(slice(0, 480, 4))
-    res = bake_take(obj, take, preset="auto", settings=RetargetSettings(filter="none"))
+    res = bake_take(obj, take, preset="auto",
+                   settings=RetargetSettings(filter="none", fps=take.rate))  # keys on the take's samples
     assert res.preset == "rigify-metarig" and res.motion.root_bone == "spine"
     pairs = {f"{b}.{s[0]}": (f"{a}{s}", f"{c}{s}") for s in ("Left", "Right") for b, a, c in
              (("upper_arm", "Shoulder", "Elbow"), ("forearm", "Elbow", "Wrist"), ("thigh", "Hip", "Knee"),
@@ -207,7 +210,8 @@ def test_euler_and_axis_angle_bones_are_keyed_in_their_own_channels(bpy_empty, s
     modes = {"ElbowLeft": "ZXY", "WristLeft": "XYZ", "ElbowRight": "AXIS_ANGLE", "KneeLeft": "YZX"}
     for bone, mode in modes.items():
         obj.pose.bones[bone].rotation_mode = mode
-    res = bake_take(obj, take, preset="kinect", settings=RetargetSettings(filter="none"))
+    res = bake_take(obj, take, preset="kinect",
+                   settings=RetargetSettings(filter="none", fps=take.rate))  # keys on the take's samples
     assert all(obj.pose.bones[b].rotation_mode == m for b, m in modes.items())
     from bpy_extras import anim_utils
     paths = {fc.data_path for fc in anim_utils.animdata_get_channelbag_for_assigned_slot(obj.animation_data).fcurves}

@@ -357,7 +357,7 @@ def test_sidebar_tab_and_preferences_are_registered(registered):
 def test_rig_action_is_detached_during_live_and_kept_safe(scene_with_rig):
     scene, obj, take, _ = scene_with_rig
     from kinect_retarget.blender.bake_take import bake_take
-    bake_take(obj, take, preset="kinect", action_name="UserAction", set_scene_range=False)
+    bake_take(obj, take, preset="kinect", action_name="UserAction")
     user_action = obj.animation_data.action
     slot = obj.animation_data.action_slot.identifier
     # stop without recording: the user's action comes back with its slot

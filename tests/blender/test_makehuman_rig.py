@@ -56,7 +56,8 @@ def test_bake_onto_makehuman_skeleton(bpy_empty, shared_data):
     obj = build_makehuman_armature(bpy, shared_data)
     rest_before = np.array([np.array(b.matrix_local) for b in obj.data.bones])
     take = load_take(shared_data / "mocap_bvh" / "131_02.bvh").slice(slice(0, 240, 4))
-    res = bake_take(obj, take, preset="auto", settings=RetargetSettings(filter="none"))
+    res = bake_take(obj, take, preset="auto",
+                   settings=RetargetSettings(filter="none", fps=take.rate))  # keys on the take's samples
     assert res.preset == "makehuman"
     src = kinect_to_blender(take.positions[res.motion.samples])
     sk = take.skeleton
@@ -101,7 +102,8 @@ def test_presets_drive_renamed_skeleton(bpy_empty, shared_data, preset):
     for old, new in RENAMES[preset].items():
         obj.data.bones[old].name = new
     take = load_take(shared_data / "kinect_v2" / "Ges03_drawlines.csv")
-    res = bake_take(obj, take, preset="auto", settings=RetargetSettings(filter="none"))
+    res = bake_take(obj, take, preset="auto",
+                   settings=RetargetSettings(filter="none", fps=take.rate))  # keys on the take's samples
     assert res.preset == preset
     upper = RENAMES[preset]["upperarm01.R"]
     src = kinect_to_blender(take.positions[res.motion.samples])

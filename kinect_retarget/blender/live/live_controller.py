@@ -171,7 +171,7 @@ class LiveController:
                 rec["frame_start"]
             settings = replace(self.settings, fps=rec["fps"], frame_start=start, root_scale=n)
             result = bake_take(obj, take, preset=self.preset, overrides=self.overrides, settings=settings,
-                               action_name=rec["name"], set_scene_range=False,
+                               action_name=rec["name"],
                                report=lambda level, msg: self.post(next(iter(level)), msg))
         except (TakeError, ValueError) as exc:
             self.post("ERROR", f"Recording kept in {path} but could not be baked: {exc}")

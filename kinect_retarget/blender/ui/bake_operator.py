@@ -10,12 +10,13 @@ from ...core.presets import load_mapping_file
 from ...core.take import TakeError
 from ...takes import load_take
 from ..bake_take import bake_take, take_display_name
+from .bake_settings import BakeOptionProps, copy_options, draw_bake_options, options_from
 from .mapping_table import table_overrides
 from .preferences import FILTER_ITEMS
 from .properties import PRESET_ITEMS, ROOT_ITEMS, target_armature
 
 
-class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper):
+class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper, BakeOptionProps):
     """Bake a recorded take (Kinect CSV/JSON, NTU, MSRC-12, UTKinect, BVH, .krtake) onto the target armature"""
 
     bl_idname = "kinect_retarget.bake_take"
@@ -27,8 +28,9 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper):
     mapping_file: StringProperty(name="Mapping JSON", subtype="FILE_PATH", default="")
     filter: EnumProperty(name="Filter", items=FILTER_ITEMS, default="default")
     root: EnumProperty(name="Root Motion", items=ROOT_ITEMS, default="xyz")
-    fps: FloatProperty(name="FPS", description="Scene rate (0: the take's rate)", default=0.0, min=0.0)
-    frame_start: IntProperty(name="Start Frame", default=1)
+    fps: FloatProperty(name="Key Rate", default=0.0, min=0.0,
+                       description="Keys per second (0: the scene's rate, or the take's with Set Scene Frame Rate)")
+    frame_start: IntProperty(name="Start Frame", default=1, description="Scene frame of the take's (part's) start")
     mirror: BoolProperty(name="Mirror", description="Swap the performer's left and right", default=False)
 
     @classmethod
@@ -43,7 +45,17 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper):
         s = getattr(context.scene, "kinect_retarget", None)
         if s is not None:
             self.preset, self.filter, self.root, self.mirror = s.preset, s.filter, s.root, s.mirror
+            copy_options(s, self)
+            self.frame_start = context.scene.frame_start
         return super().invoke(context, event)
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        for name in ("preset", "mapping_file", "filter", "root", "mirror", "fps", "frame_start"):
+            layout.prop(self, name)
+        draw_bake_options(layout, self)
 
     def execute(self, context):
         obj = target_armature(context)
@@ -59,13 +71,14 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper):
                 overrides.update(load_mapping_file(bpy.path.abspath(self.mapping_file)))
             settings = RetargetSettings(filter=self.filter, root_mode=self.root, fps=self.fps or None,
                                         frame_start=self.frame_start, mirror=self.mirror)
+            options = options_from(self)
         except (TakeError, ValueError) as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
         wm.progress_begin(0, 100)
         try:
             bake_take(obj, take, preset=self.preset, overrides=overrides or None, settings=settings,
-                      report=self.report, progress=lambda x: wm.progress_update(int(100 * x)))
+                      options=options, report=self.report, progress=lambda x: wm.progress_update(int(100 * x)))
         except (TakeError, ValueError) as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}

@@ -4,6 +4,7 @@ from __future__ import annotations
 import bpy
 
 from ..live import live_controller
+from .bake_settings import draw_bake_options
 from .properties import target_armature
 
 
@@ -148,5 +149,19 @@ class KINECT_RETARGET_PT_options(_KinectPanel, bpy.types.Panel):
         col.prop(s, "bake_on_stop")
 
 
+class KINECT_RETARGET_PT_bake(_KinectPanel, bpy.types.Panel):
+    """Options of Bake Take and of the bake when a recording stops (the take range applies to Bake Take)."""
+    bl_label = "Bake"
+    bl_parent_id = "KINECT_RETARGET_PT_main"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        draw_bake_options(layout, context.scene.kinect_retarget)
+        layout.operator("kinect_retarget.bake_take", text="Bake Take…", icon="ACTION")
+
+
 CLASSES = (KINECT_RETARGET_PT_main, KINECT_RETARGET_PT_target, KINECT_RETARGET_PT_mapping,
-           KINECT_RETARGET_PT_options)
+           KINECT_RETARGET_PT_options, KINECT_RETARGET_PT_bake)

@@ -10,6 +10,7 @@ from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProp
 
 from ...core.presets import PRESET_NAMES
 from ...core.retarget import ROOT_MODES
+from .bake_settings import BakeOptionProps
 from .preferences import FILTER_ITEMS, SOURCE_ITEMS, get_preferences
 
 PRESET_ITEMS = [(p, p.replace("-", " ").title() if p != "auto" else "Auto", f"Bone-mapping preset: {p}")
@@ -30,7 +31,7 @@ class KinectRetargetBoneMap(bpy.types.PropertyGroup):
     enabled: BoolProperty(name="Enabled", default=True, description="Drive this bone")
 
 
-class KinectRetargetSettings(bpy.types.PropertyGroup):
+class KinectRetargetSettings(bpy.types.PropertyGroup, BakeOptionProps):
     initialised: BoolProperty(default=False, options={"HIDDEN"})
     source: EnumProperty(name="Source", items=SOURCE_ITEMS, default="TAKE")
     take_path: StringProperty(name="Take", subtype="FILE_PATH", description="Take to play live")

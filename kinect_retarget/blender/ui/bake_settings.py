@@ -1,0 +1,76 @@
+"""The bake options as Blender properties, one definition shared by the Bake Take operator (its file browser's
+side panel and redo panel) and the sidebar (scene.kinect_retarget), and how both draw them."""
+from __future__ import annotations
+
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty
+
+from ...core.bake_options import BakeOptions
+
+DESTINATION_ITEMS = [
+    ("NEW", "New Action", "Key a new Action and assign it (the rig's previous Action is kept in the file)"),
+    ("CURRENT", "Current Action", "Key into the Action the rig plays now, replacing its keys in the baked range"),
+    ("NLA", "NLA Strip", "Key a new Action and push it to the NLA as a strip named after the take"),
+]
+RANGE_UNIT_ITEMS = [("seconds", "Seconds", "Take range in seconds from the take's start"),
+                    ("frames", "Take Frames", "Take range in the take's own frames, counted from 0")]
+
+
+class BakeOptionProps:
+    """Mixin: the bake options as properties (for an Operator or a PropertyGroup)."""
+    set_scene_fps: BoolProperty(
+        name="Set Scene Frame Rate", default=False,
+        description="Run the scene at the take's rate. Off: the scene keeps its rate and the take is resampled "
+                    "to it (rotations by slerp)")
+    extend_scene_range: BoolProperty(
+        name="Extend Scene Range", default=False,
+        description="Grow the scene's frame range to hold the baked keys (it is never shortened)")
+    use_take_range: BoolProperty(name="Part of the Take", default=False,
+                                 description="Bake only part of the take")
+    range_unit: EnumProperty(name="Unit", items=RANGE_UNIT_ITEMS, default="seconds")
+    range_start: FloatProperty(name="From", default=0.0, min=0.0, description="Start of the part to bake")
+    range_end: FloatProperty(name="To", default=10.0, min=0.0, description="End of the part to bake (inclusive)")
+    key_step: IntProperty(name="Key Step", default=1, min=1, soft_max=10,
+                          description="Key every N scene frames")
+    reduce_keys: BoolProperty(name="Reduce Keys", default=False,
+                              description="Remove keys that linear interpolation reproduces within the tolerances")
+    tolerance_deg: FloatProperty(name="Rotation Tolerance (°)", default=0.5, min=0.001, soft_max=5.0,
+                                 description="Largest rotation error key reduction may leave, in degrees")
+    tolerance_mm: FloatProperty(name="Location Tolerance (mm)", default=1.0, min=0.001, soft_max=50.0,
+                                description="Largest root-location error key reduction may leave, in millimetres")
+    destination: EnumProperty(name="Keys Into", items=DESTINATION_ITEMS, default="NEW")
+
+
+def options_from(owner) -> BakeOptions:
+    """BakeOptions from an operator or the scene settings holding BakeOptionProps."""
+    use = owner.use_take_range
+    return BakeOptions(range_start=owner.range_start if use else None, range_end=owner.range_end if use else None,
+                       range_unit=owner.range_unit, step=owner.key_step, reduce=owner.reduce_keys,
+                       tolerance_deg=owner.tolerance_deg, tolerance_mm=owner.tolerance_mm,
+                       into_current=owner.destination == "CURRENT", push_nla=owner.destination == "NLA",
+                       set_scene_fps=owner.set_scene_fps, extend_scene_range=owner.extend_scene_range)
+
+
+def copy_options(src, dst) -> None:
+    for name in BakeOptionProps.__annotations__:
+        setattr(dst, name, getattr(src, name))
+
+
+def draw_bake_options(layout, owner) -> None:
+    col = layout.column(heading="Scene")
+    col.prop(owner, "set_scene_fps")
+    col.prop(owner, "extend_scene_range")
+    col = layout.column(heading="Take")
+    col.prop(owner, "use_take_range")
+    sub = col.column(align=True)
+    sub.active = owner.use_take_range
+    sub.prop(owner, "range_unit")
+    sub.prop(owner, "range_start")
+    sub.prop(owner, "range_end")
+    col = layout.column(heading="Keys")
+    col.prop(owner, "key_step")
+    col.prop(owner, "reduce_keys")
+    sub = col.column(align=True)
+    sub.active = owner.reduce_keys
+    sub.prop(owner, "tolerance_deg")
+    sub.prop(owner, "tolerance_mm")
+    layout.prop(owner, "destination")
