@@ -111,14 +111,17 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
     whole = take
     take, part = take_range(take, options)
     rate = float(settings.fps or (take.rate if options.set_scene_fps else scene_rate(scene)))
-    # solve at the take's own samples, then key on the scene's frame grid
-    pipeline, used = make_pipeline(obj, take.skeleton, preset, overrides, replace(settings, fps=None))
+    # at the take's own rate each sample keys its frame; otherwise solve at the take's samples and key on the
+    # scene's frame grid
+    on_samples = options.step == 1 and (options.keys_on_samples or abs(rate - take.rate) < 1e-6)
+    pipeline, used = make_pipeline(obj, take.skeleton, preset, overrides,
+                                   replace(settings, fps=rate if on_samples else None))
     for problem in mapping_problems(pipeline.rig.bone_names, overrides):
         report({"WARNING"}, problem)
     for warning in take.metadata.get("warnings", ()):  # what the reader dropped (bad samples, a cut-off line)
         report({"WARNING"}, warning)
     motion = pipeline.process_take(take)
-    if abs(rate - take.rate) > 1e-6 or options.step > 1:  # at the take's own rate each sample keys its frame
+    if not on_samples:
         motion = resample_motion(motion, take.times[motion.samples] - take.times[0], rate, settings.frame_start,
                                  options.step)
     if progress:

@@ -25,6 +25,8 @@ class BakeOptions:
     push_nla: bool = False             # push the baked Action to the NLA as a strip named after the take
     set_scene_fps: bool = False        # run the scene at the bake's rate
     extend_scene_range: bool = False   # grow the scene's frame range to hold the keys (never shrinks it)
+    keys_on_samples: bool = False      # key each sample at its nearest frame, no resampling (live's recording:
+                                       # the baked keys equal the poses live showed)
 
     def __post_init__(self) -> None:
         if self.range_unit not in RANGE_UNITS:

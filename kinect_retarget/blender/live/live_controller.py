@@ -24,6 +24,7 @@ from ...live.session import LiveSession
 from ...sources import OscReceiver, SourceError, TakePlayback, UsbKinectSource
 from ...takes import load_take
 from ..bake_take import bake_take, make_pipeline, set_scene_rate
+from ..ui.bake_settings import recording_bake_options
 from ..ui.mapping_table import table_overrides
 from ..io.pose_apply import apply_frame_pose, restore_pose, snapshot_pose
 from ..io.evaluated_solve import correct_for_evaluation, read_rotations
@@ -171,7 +172,7 @@ class LiveController:
                 rec["frame_start"]
             settings = replace(self.settings, fps=rec["fps"], frame_start=start, root_scale=n)
             result = bake_take(obj, take, preset=self.preset, overrides=self.overrides, settings=settings,
-                               action_name=rec["name"],
+                               action_name=rec["name"], options=recording_bake_options(self.scene()),
                                report=lambda level, msg: self.post(next(iter(level)), msg))
         except (TakeError, ValueError) as exc:
             self.post("ERROR", f"Recording kept in {path} but could not be baked: {exc}")

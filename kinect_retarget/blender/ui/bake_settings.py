@@ -2,6 +2,8 @@
 side panel and redo panel) and the sidebar (scene.kinect_retarget), and how both draw them."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty
 
 from ...core.bake_options import BakeOptions
@@ -48,6 +50,15 @@ def options_from(owner) -> BakeOptions:
                        tolerance_deg=owner.tolerance_deg, tolerance_mm=owner.tolerance_mm,
                        into_current=owner.destination == "CURRENT", push_nla=owner.destination == "NLA",
                        set_scene_fps=owner.set_scene_fps, extend_scene_range=owner.extend_scene_range)
+
+
+def recording_bake_options(scene) -> BakeOptions:
+    """The sidebar's options for the bake when a recording stops: its keys land on the frames live showed
+    them (no take range, no resampling), and the scene's rate is left alone."""
+    if scene is None or getattr(scene, "kinect_retarget", None) is None:
+        return BakeOptions(keys_on_samples=True)
+    return replace(options_from(scene.kinect_retarget), range_start=None, range_end=None, set_scene_fps=False,
+                   keys_on_samples=True)
 
 
 def copy_options(src, dst) -> None:
