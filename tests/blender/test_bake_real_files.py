@@ -58,11 +58,14 @@ def test_operator_reports_dropped_samples(registered, tmp_path, capfd):
     obj = new_generated_rig(bpy.context.scene, load_take(path))
     bpy.context.view_layer.objects.active = obj
     capfd.readouterr()
-    assert bpy.ops.kinect_retarget.bake_take(filepath=str(path), preset="kinect") == {"FINISHED"}
+    assert bpy.ops.kinect_retarget.bake_take(filepath=str(path), preset="kinect",
+                                             set_scene_fps=True) == {"FINISHED"}
     out = capfd.readouterr()
     assert "2 joint samples in 1 frame were NaN" in out.out + out.err and "first at line 31" in out.out + out.err
     assert obj.animation_data.action is not None
-    assert (bpy.context.scene.frame_start, bpy.context.scene.frame_end) == (21, 80)
+    # keys at the take's rate from its first frame with a body; the scene's range is left as it was
+    assert tuple(obj.animation_data.action.frame_range) == (21, 80)
+    assert (bpy.context.scene.frame_start, bpy.context.scene.frame_end) == (1, 250)
 
 
 def test_bake_take_reports_reader_warnings(bpy_empty, tmp_path):
