@@ -148,8 +148,17 @@ def test_explicit_scale_and_unit_heuristic(shared_data, tmp_path):
     (tmp_path / "renamed.bvh").write_text(renamed)
     motion = bvh.read_bvh_skeleton(tmp_path / "renamed.bvh")
     assert motion.family is None and motion.units_to_metres == pytest.approx(CMU_UNIT)
-    with pytest.raises(TakeError, match=r"renamed\.bvh: BVH skeleton not recognised"):
-        bvh.read(tmp_path / "renamed.bvh")
+    # names decide nothing: the renamed skeleton maps by structure onto the same joints
+    np.testing.assert_allclose(bvh.read(tmp_path / "renamed.bvh", min_range=None).positions, ref.positions)
+    # a skeleton that is no humanoid (one long chain) is refused with the reason
+    lines = ["HIERARCHY", "ROOT a", "{", "OFFSET 0 0 0", "CHANNELS 6 Xposition Yposition Zposition Zrotation "
+             "Yrotation Xrotation"] + sum([[f"JOINT s{i}", "{", "OFFSET 0 10 0", "CHANNELS 3 Zrotation Yrotation "
+                                           "Xrotation"] for i in range(6)], []) + \
+        ["End Site", "{", "OFFSET 0 10 0", "}"] + ["}"] * 7 + ["MOTION", "Frames: 2", "Frame Time: 0.04"] + \
+        [" ".join(["0"] * 24)] * 2
+    (tmp_path / "snake.bvh").write_text("\n".join(lines) + "\n")
+    with pytest.raises(TakeError, match=r"snake\.bvh: BVH skeleton not recognised as a humanoid: no node where"):
+        bvh.read(tmp_path / "snake.bvh")
     with pytest.raises(TakeError, match="scale must be a positive"):
         bvh.read(shared_data / "mocap_bvh" / "131_01.bvh", scale=-1.0)
 
