@@ -227,7 +227,7 @@ class _Mapper:
         if fan is not None:
             w = k.index(fan)
             return {"Shoulder": k[w - 2], "Elbow": k[w - 1], "Wrist": fan,
-                    "Hand": self._hand_child(k[w - 1], fan), "hand_how": "finger base most in line with the forearm"}
+                    "Hand": self._hand_child(k[w - 1], fan), "hand_how": "base of the longest finger"}
         if k[-1] != chain[-1]:  # the chain's end collapsed onto the last joint: no hand length at all
             return {"Shoulder": k[-3], "Elbow": k[-2], "Wrist": k[-1], "Hand": None,
                     "hand_how": "no hand node: extrapolated along the forearm"}
@@ -244,25 +244,18 @@ class _Mapper:
                 "hand_how": f"{what} after the wrist"}
 
     def _hand_child(self, elbow: int, wrist: int) -> int:
-        """The wrist's child most in line with the forearm (the middle finger), past zero-length carpals."""
-        j = wrist
-        for _ in range(3):
-            fore = self.pos[:, wrist] - self.pos[:, elbow]
-            best, best_cos = None, -2.0
-            for c in self.kids[j]:
-                d = self.pos[:, c] - self.pos[:, wrist]
-                den = np.linalg.norm(d, axis=-1) * np.linalg.norm(fore, axis=-1)
-                cos = float(np.median(np.einsum("fi,fi->f", d, fore) / np.where(den > 0, den, 1.0)))
-                if den.max() == 0:
-                    cos = -1.0
-                if cos > best_cos:
-                    best, best_cos = c, cos
-            if best is None:
-                return j
-            j = best
-            if self._dist(wrist, j) >= SHORT * self.size:
-                return j
-        return j
+        """Base of the longest finger (the middle one; ties go to the one reaching furthest along the forearm),
+        past zero-length nodes."""
+        fore = self.pos[:, wrist] - self.pos[:, elbow]
+        fore /= np.maximum(np.linalg.norm(fore, axis=-1, keepdims=True), 1e-12)
+
+        def along(c: int) -> float:
+            tip = self._chain(c, wrist)[-1]
+            reach = float(np.median(np.einsum("fi,fi->f", self.pos[:, tip] - self.pos[:, wrist], fore)))
+            return self.seg[c] + self.reach[c] + 0.1 * reach
+
+        chain = self._chain(max(self.kids[wrist], key=along), wrist)
+        return next((j for j in chain[1:] if self._dist(wrist, j) >= SHORT * self.size), chain[-1])
 
     # --------------------------------------------------------------------------------------------- run
 
