@@ -94,7 +94,11 @@ def cmu_takes(data: Path) -> dict[str, Take]:
         full = bvh.read(data / rel)
         take = decimate(full, TARGET_RATE)
         frame_time = float(full.times[1])  # the BVH's Frame Time (times are frame * frame_time)
-        take.metadata = {**take.metadata, "source": f"CMU Graphics Lab Motion Capture Database, {trial} "
+        # the reader's report on the mapping (bvh_mapping, bvh_unit, ...) stays out of the headers: `info` on
+        # the BVH shows it, and the joints it describes are the ones the takes hold
+        meta = {k: v for k, v in take.metadata.items() if k in ("source_file", "bvh_family", "bvh_units_to_metres",
+                                                                  "virtual_camera", "converted")}
+        take.metadata = {**meta, "source": f"CMU Graphics Lab Motion Capture Database, {trial} "
                          f"({motion}); {release}", **CMU,
                          "resampled": f"{frame_time:g} s frames, every 4th frame kept (120 -> 30 fps)"}
         takes[name] = take

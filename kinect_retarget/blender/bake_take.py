@@ -159,10 +159,18 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
                      + (f"; key reduction removed {reduction.removed} keys (max error {reduction.max_deg:.3f}°, "
                         f"{reduction.max_mm:.3f} mm)" if reduction else "")
                      + (f"; left alone (the take has no position for their joints): {', '.join(skipped)}"
-                        if skipped else ""))
+                        if skipped else "") + _reading(take.metadata))
     if progress:
         progress(1.0)
     return BakeResult(action, motion, used, (first, last), reduction, strip)
+
+
+def _reading(meta: dict) -> str:
+    """What was guessed while reading a BVH file, for the bake report."""
+    if "bvh_unit" not in meta:
+        return ""
+    return (f"; BVH read in {meta['bvh_unit']}, {meta['bvh_up_axis']} up, figure "
+            f"{meta['bvh_standing_height_m']:.2f} m tall, {meta['bvh_position_channels']}")
 
 
 def take_display_name(path: str) -> str:

@@ -33,6 +33,8 @@ def add_parsers(sub) -> None:
                                             "rate in the new scene made without --rig)")
     p.add_argument("--frame-start", type=int, default=1, help="scene frame of the take's (range's) start")
     p.add_argument("--mirror", action="store_true", help="swap the performer's left and right")
+    p.add_argument("--scale", type=float, help="BVH only: metres per file unit (default: guessed from the "
+                                               "figure's standing height)")
     add_bake_option_args(p)
     p.set_defaults(handler=run_bake)
 
@@ -63,14 +65,20 @@ def bake_options_from_args(args) -> BakeOptions:
                        set_scene_fps=args.set_scene_fps, extend_scene_range=args.extend_range)
 
 
+BVH_FIELDS = {"bvh_unit": "unit", "bvh_standing_height_m": "standing_height_m", "bvh_up_axis": "up_axis",
+              "bvh_position_channels": "position_channels", "bvh_mapping_notes": "mapping_notes",
+              "bvh_mapping": "mapping"}
+
+
 def take_summary(path: str) -> dict:
     take = load_take(path)
     meta = take.metadata
+    bvh = {short: meta[key] for key, short in BVH_FIELDS.items() if key in meta}
     return {"file": os.path.basename(path), "format": take.source_format, "skeleton": take.skeleton.name,
             "joints": len(take.skeleton), "frames": take.frame_count, "duration_s": round(take.duration, 3),
             "rate_fps": take.rate, "time_unit": meta.get("time_unit", "s"),
             "tracked_fraction": round(take.tracked_fraction, 4),
-            "frames_with_body": int(np.count_nonzero(take.any_tracked)), **dropped_summary(meta),
+            "frames_with_body": int(np.count_nonzero(take.any_tracked)), **dropped_summary(meta), **bvh,
             **({"warnings": meta["warnings"]} if meta.get("warnings") else {})}
 
 
@@ -90,7 +98,12 @@ def run_info(args) -> int:
     else:
         width = max(len(k) for k in info)
         for k, v in info.items():
-            print(f"{k:<{width}}  {v}")
+            if isinstance(v, dict):  # the BVH mapping, joint by joint
+                print(k)
+                for joint, how in v.items():
+                    print(f"  {joint:<{width - 2}}  {how}")
+            else:
+                print(f"{k:<{width}}  {'; '.join(v) if isinstance(v, list) else v}")
     return 0
 
 
@@ -98,7 +111,7 @@ def run_bake(args) -> int:
     from ..core.pipeline import RetargetSettings
     from ..core.presets import load_mapping_file
 
-    take = load_take(args.take)  # bad input fails here, before Blender starts
+    take = load_take(args.take, scale=args.scale)  # bad input fails here, before Blender starts
     take.metadata.setdefault("name", os.path.splitext(os.path.basename(args.take))[0])
     settings = RetargetSettings(filter=args.filter, root_mode=args.root, fps=args.fps,
                                 frame_start=args.frame_start, mirror=args.mirror)

@@ -41,6 +41,7 @@ ROLES = KINECT_V1.joints
 SHORT = 0.03        # a segment shorter than this fraction of the figure's size is a zero-length helper
 BIG_BRANCH = 0.15   # a pelvis branch (spine, leg) reaches at least this fraction of the figure's size
 NECK_BRANCH = 0.08  # a chest branch (arm, neck) reaches at least this much
+FINGER = 0.015      # a finger base at least this far from the wrist stands for the hand (not a carpal node)
 ARM_BRANCH = 0.2    # and the two arms at least this much (breasts and other helpers are shorter)
 STILL_DEG = 0.5     # a node whose chain never bends more than this over the take is a twist node
 TWIST_NAME = re.compile(r"twist|roll|upperarm0?2|lowerarm0?2|upperleg0?2|lowerleg0?2|helper|adjust|share",
@@ -83,9 +84,7 @@ class StructureMapping:
 
     @property
     def up(self) -> np.ndarray:
-        v = np.zeros(3)
-        v[self.up_axis] = self.up_sign
-        return v
+        return np.eye(3)[self.up_axis] * self.up_sign
 
     def indices(self) -> dict[str, tuple[int, ...]]:
         """{role: nodes to average} (empty tuple: none, the caller extrapolates)."""
@@ -235,11 +234,10 @@ class _Mapper:
         # is the last segment a hand (upper arm, forearm, hand) or a forearm (clavicle, upper arm, forearm)?
         hand_fit = abs(np.log(s[-3] / s[-2] / 1.2)) + abs(np.log(s[-1] / s[-2] / 0.45)) if len(s) >= 3 else 0.0
         wrist_fit = abs(np.log(s[-2] / s[-1] / 1.2)) + (abs(np.log(s[-3] / s[-1] / 0.55)) if len(s) >= 3 else 1.0)
+        what = "end site" if self.ends[k[-1]] else "last node"
         if len(k) >= 5 and wrist_fit < hand_fit:
-            what = "end site" if self.ends[k[-1]] else "last node"
             return {"Shoulder": k[-3], "Elbow": k[-2], "Wrist": k[-1], "Hand": None,
                     "hand_how": f"no hand ({what} at the wrist): extrapolated along the forearm"}
-        what = "end site" if self.ends[k[-1]] else "last node"
         return {"Shoulder": k[-4], "Elbow": k[-3], "Wrist": k[-2], "Hand": k[-1],
                 "hand_how": f"{what} after the wrist"}
 
@@ -255,7 +253,7 @@ class _Mapper:
             return self.seg[c] + self.reach[c] + 0.1 * reach
 
         chain = self._chain(max(self.kids[wrist], key=along), wrist)
-        return next((j for j in chain[1:] if self._dist(wrist, j) >= SHORT * self.size), chain[-1])
+        return next((j for j in chain[1:] if self._dist(wrist, j) >= FINGER * self.size), chain[-1])
 
     # --------------------------------------------------------------------------------------------- run
 
@@ -284,8 +282,7 @@ class _Mapper:
         top = max(head_chain[1:], key=lambda j: self._dist(chest, j))
         head_chain = head_chain[:head_chain.index(top) + 1]
         up_axis, up_sign = self._up(top, leg_a, leg_b)
-        up = np.zeros(3)
-        up[up_axis] = up_sign
+        up = np.eye(3)[up_axis] * up_sign
         forward, a_is_left = self._facing(up, leg_a, leg_b, legs)
         if not a_is_left:
             leg_a, leg_b = leg_b, leg_a
@@ -352,16 +349,14 @@ class _Mapper:
     def _roles(self, pelvis, chest, spine, head_chain, top, arm_l, arm_r, leg_l, leg_r) -> dict[str, RoleMatch]:
         nm = self.names
         roles = {"HipCenter": RoleMatch(pelvis, (pelvis,), "root of the spine and both legs")}
-        path = self._joints(self._path_up(chest, pelvis))
-        inner = path[1:-1]
-        if inner:
-            arc = np.cumsum([0.0] + [self._dist(a, b) for a, b in zip(path, path[1:])])
-            mid = min(range(1, len(path) - 1), key=lambda i: abs(arc[i] - arc[-1] / 2))
-            roles["Spine"] = RoleMatch(path[mid], (path[mid],), "spine joint halfway up to the chest")
+        inner = self._joints(self._path_up(chest, pelvis))[1:-1]
+        if inner:  # the upper spine: its highest joint below the chest, averaged with the chest
+            roles["Spine"] = RoleMatch(inner[-1], (inner[-1], chest), f"between the spine joint below the chest "
+                                       f"and {nm[chest]}")
         else:
             roles["Spine"] = RoleMatch(None, (pelvis, chest), f"no spine joint: halfway from pelvis to {nm[chest]}")
         roles["ShoulderCenter"] = RoleMatch(chest, (arm_l["Shoulder"], arm_r["Shoulder"]),
-                                            f"between the upper-arm heads (arms leave the spine at {nm[chest]})")
+                                            f"between the upper-arm heads; the arms leave the spine at {nm[chest]}")
         base = next((j for j in reversed(head_chain[1:-1]) if len(self.kids[j]) >= 2), None)
         if base is None:
             base = head_chain[-2] if len(head_chain) >= 3 else top

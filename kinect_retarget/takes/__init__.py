@@ -29,9 +29,14 @@ def detect_format(path: str | os.PathLike) -> str:
     raise TakeError(f"{path}: unknown take format (supported: {', '.join(READERS)})")
 
 
-def load_take(path: str | os.PathLike) -> Take:
+def load_take(path: str | os.PathLike, scale: float | None = None) -> Take:
+    """`scale`: metres per file unit, for BVH files (other formats are in metres already)."""
     fmt = detect_format(path)
-    return import_module(f".{fmt}", __name__).read(path)
+    if scale is None:
+        return import_module(f".{fmt}", __name__).read(path)
+    if fmt != "bvh":
+        raise TakeError(f"{os.fspath(path)}: scale applies to BVH files only ({fmt} takes are in metres already)")
+    return import_module(f".{fmt}", __name__).read(path, scale=scale)
 
 
 __all__ = ["load_take", "detect_format", "Take", "TakeError", "READERS"]

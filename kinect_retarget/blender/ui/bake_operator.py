@@ -32,6 +32,8 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper, BakeOptionP
                        description="Keys per second (0: the scene's rate, or the take's with Set Scene Frame Rate)")
     frame_start: IntProperty(name="Start Frame", default=1, description="Scene frame of the take's (part's) start")
     mirror: BoolProperty(name="Mirror", description="Swap the performer's left and right", default=False)
+    scale: FloatProperty(name="BVH Scale", description="BVH only: metres per file unit (0: guess from the "
+                         "figure's standing height)", default=0.0, min=0.0, precision=4)
 
     @classmethod
     def poll(cls, context):
@@ -61,7 +63,7 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper, BakeOptionP
         obj = target_armature(context)
         wm = context.window_manager
         try:
-            take = load_take(self.filepath)
+            take = load_take(self.filepath, scale=self.scale or None)
             take.metadata.setdefault("name", take_display_name(self.filepath))
             # the sidebar's mapping table, then a mapping file on top
             s = getattr(context.scene, "kinect_retarget", None)
