@@ -26,7 +26,7 @@ class Figure:
 
 
 def load(path) -> Figure:
-    sk, frame_time, values = read_bvh_text(path)
+    sk, frame_time, values, _ = read_bvh_text(path)
     rot, trans = _local_transforms(sk, values)
     return Figure(list(sk.names), sk.parents.copy(), sk.offsets.copy(), sk.is_end_site.copy(),
                   quat.to_matrix(rot), trans[:, 0].copy(), frame_time)
