@@ -19,14 +19,14 @@ from kinect_retarget.takes import krtake, load_take
 FRAMES = 10_000
 
 
-def long_take() -> Take:
-    """10,000 frames of real Kinect v1 motion: the CMU-derived sample takes back to back."""
+def long_take(frames: int = FRAMES) -> Take:
+    """`frames` frames of real Kinect v1 motion: the CMU-derived sample takes back to back."""
     parts = [load_take(SAMPLE_TAKES / f) for f in sorted(os.listdir(SAMPLE_TAKES)) if f.startswith("kinect_v1")]
     pos = np.concatenate([p.positions for p in parts])
     states = np.concatenate([p.states for p in parts])
-    reps = int(np.ceil(FRAMES / len(pos)))
-    pos, states = np.tile(pos, (reps, 1, 1))[:FRAMES], np.tile(states, (reps, 1))[:FRAMES]
-    return Take(parts[0].skeleton, pos, states, np.arange(FRAMES) / 30.0, 30.0, metadata={"name": "long"})
+    reps = int(np.ceil(frames / len(pos)))
+    pos, states = np.tile(pos, (reps, 1, 1))[:frames], np.tile(states, (reps, 1))[:frames]
+    return Take(parts[0].skeleton, pos, states, np.arange(frames) / 30.0, 30.0, metadata={"name": "long"})
 
 
 def write_bvh(path: str, take: Take, pipe: RetargetPipeline, motion) -> None:

@@ -19,9 +19,8 @@ from ..core.rotation_modes import channel_values
 from ..core.skeletons import Skeleton
 from ..core.take import Take
 from .io.action_writer import bake_motion, push_to_nla
-from .io.evaluated_solve import correct_for_evaluation
+from .io.armature_probe import constrained_summary, solve_baked
 from .io.kinect_rig import build_kinect_rig
-from .io.pose_apply import restore_pose, snapshot_pose
 from .io.rig_reader import fk_switch_bones, has_constrained_ancestry, target_rig_from_object
 
 Report = Callable[[set, str], None]
@@ -130,19 +129,10 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
     if used == "rigify":
         extra = [(f'pose.bones["{escape_identifier(b)}"]["IK_FK"]', b, np.ones(1)) for b in fk_switch_bones(obj)]
     if has_constrained_ancestry(obj, motion.bone_names):
-        saved = {name: obj.pose.bones[name]["IK_FK"] for _, name, _ in extra}
-        saved_pose = snapshot_pose(obj)
-        try:
-            for _, name, _ in extra:
-                obj.pose.bones[name]["IK_FK"] = 1.0
-            n = len(motion.frames)
-            motion.quats = correct_for_evaluation(
-                obj, motion.bone_names, motion.quats, motion.root_bone, motion.root_location,
-                motion.extras["desired"], (lambda f: progress(0.3 + 0.6 * f / n)) if progress else None)
-        finally:  # the evaluation posed the rig; put the pose and the switches back whatever happened
-            restore_pose(obj, saved_pose)
-            for name, value in saved.items():
-                obj.pose.bones[name]["IK_FK"] = value
+        n = len(motion.frames)
+        model = solve_baked(obj, pipeline.rig, motion, {name: 1.0 for _, name, _ in extra},
+                            (lambda f: progress(0.3 + 0.6 * f / n)) if progress else None)
+        report({"INFO"}, constrained_summary(model))
     take_name = whole.metadata.get("name", "take")
     name = action_name or f"{obj.name}_{take_name}"
     reduction = _reduce(obj, motion, options)

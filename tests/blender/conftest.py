@@ -35,3 +35,40 @@ def rigify_rig_path(tmp_path_factory):
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     bpy.ops.wm.read_factory_settings(use_empty=True)
     return path
+
+
+def add_unlearnable_parents(bpy, obj, frames: tuple[int, int]):
+    """Give the generated Kinect rig two parents no relation explains (issue 15's fallback): the left
+    elbow hangs from a bone with a Damped Track to an empty, the left knee from a bone whose Copy Rotation
+    influence is driven by a custom property of another empty, keyed to change over `frames`. The
+    rig is the test's own, so editing its bones here is fine."""
+    scene = bpy.context.scene
+    aim = bpy.data.objects.new("Aim", None)
+    aim.location = (0.8, -1.5, 2.0)
+    knob = bpy.data.objects.new("Knob", None)
+    for o in (aim, knob):
+        scene.collection.objects.link(o)
+    knob["follow"] = 0.0
+    knob.keyframe_insert('["follow"]', frame=frames[0])
+    knob["follow"] = 1.0
+    knob.keyframe_insert('["follow"]', frame=frames[1])
+    bpy.context.view_layer.objects.active = obj
+    bpy.ops.object.mode_set(mode="EDIT")
+    eb = obj.data.edit_bones
+    for mch, parent, child in (("MCH-aim", "ShoulderLeft", "ElbowLeft"), ("MCH-knee", "HipLeft", "KneeLeft")):
+        b = eb.new(mch)
+        b.head, b.tail, b.roll = eb[child].head, eb[child].tail, eb[child].roll
+        b.parent = eb[parent]
+        eb[child].parent = b
+    bpy.ops.object.mode_set(mode="OBJECT")
+    pb = obj.pose.bones
+    track = pb["MCH-aim"].constraints.new("DAMPED_TRACK")
+    track.target = aim
+    rot = pb["MCH-knee"].constraints.new("COPY_ROTATION")
+    rot.target, rot.subtarget = obj, "SpineBase"
+    fc = rot.driver_add("influence")
+    var = fc.driver.variables.new()
+    var.name, var.type = "var", "SINGLE_PROP"
+    var.targets[0].id_type, var.targets[0].id, var.targets[0].data_path = "OBJECT", knob, '["follow"]'
+    fc.driver.expression = "var"
+    return aim, knob

@@ -16,9 +16,9 @@ import bpy
 import numpy as np
 from bpy.app.handlers import persistent
 
+from ...core.parent_fit import relative_to_parent
 from ...core.pipeline import RetargetSettings
 from ...core.take import TakeError
-from ...core.constrained_parent import ConstrainedParentCorrection
 from ...core.performer_calibration import PROPERTY as CALIBRATION_PROPERTY, Calibration, CalibrationError
 from ...live.session import LiveSession
 from ...sources import OscReceiver, SourceError, TakePlayback, UsbKinectSource
@@ -27,10 +27,10 @@ from ..bake_take import bake_take, make_pipeline, set_scene_rate
 from ..ui.bake_settings import recording_bake_options
 from ..ui.mapping_table import table_overrides
 from ..io.pose_apply import apply_frame_pose, restore_pose, snapshot_pose
-from ..io.evaluated_solve import correct_for_evaluation, read_rotations
+from ..io.armature_probe import ArmatureEvaluator, constrained_summary, probe_parents, read_rotations, solve_frames
 from ..ui.preferences import get_preferences
 from ..ui.properties import ensure_defaults, target_armature
-from ..io.rig_reader import constrained_bones, fk_switch_bones
+from ..io.rig_reader import fk_switch_bones, has_constrained_ancestry
 
 usb_source_factory = None  # set by the USB panel (usb_panel.py): simulated Kinect, device freed from its preview
 TIMER_INTERVAL = 1 / 120  # pump often: latency is arrival -> applied, and an empty pump costs microseconds
@@ -53,13 +53,18 @@ class LiveController:
         self.started_at = time.perf_counter()
         self._saved = saved   # the rig's pose, action and switches before live: put back by finish()
         self._rigify_fk(obj)
+        self._switches = {name: 1.0 for name in fk_switch_bones(obj)}   # the copy is set the same way
         pipeline = session.pipeline
-        corrector = ConstrainedParentCorrection(pipeline.rig, pipeline.bone_names, constrained_bones(obj))
-        self.corrector = corrector if corrector.active else None
-        self.update_after_apply = bool(bpy.app.background)
-        self.exact = bool(scene.kinect_retarget.exact_constrained)
-        if self.corrector is not None:
-            self._read = [(b, pipeline.rig.bone_names[b]) for b in self.corrector.read]
+        self.model = None       # learned constrained parents (issue 15): exact live poses in numpy
+        self.evaluator = None   # the armature copy for Exact on Constrained Rigs, only with fallback bones
+        if has_constrained_ancestry(obj, pipeline.bone_names):
+            with ArmatureEvaluator(obj, pipeline.rig.bone_names, self._switches) as evaluator:
+                self.model = probe_parents(evaluator, obj, pipeline.rig, pipeline.bone_names, pipeline.root_bone)
+            self.reports.append(("WARNING" if self.model.fallback else "INFO", constrained_summary(self.model)))
+        fallback = self.model is not None and bool(self.model.fallback)
+        self.update_after_apply = bool(bpy.app.background) and fallback
+        # exact costs Blender evaluations, so it is asked for only where a bone has no learned relation
+        self.exact = bool(scene.kinect_retarget.exact_constrained) and fallback
 
     # -- helpers -------------------------------------------------------------------------------------------
     def obj(self):
@@ -85,26 +90,34 @@ class LiveController:
         obj = self.obj()
         if obj is None:
             raise RuntimeError(f"armature {self.obj_name!r} no longer exists")
-        if self.corrector is not None:
-            desired = pose.desired
-            pose.quats = self.corrector.correct(pose.quats, self._evaluated(obj), desired)
-            if self.exact:  # the bake's own correction, from this close start
-                pose.quats = correct_for_evaluation(obj, pose.bone_names, pose.quats[None], pose.root_bone,
-                                                    pose.root_location[None], desired[None])[0]
+        model = self.model
+        if model is not None:
+            if self.exact:  # fallback bones evaluated on the armature copy until they settle
+                if self.evaluator is None:
+                    self.evaluator = ArmatureEvaluator(obj, model.rig.bone_names, self._switches)
+                pose.quats = solve_frames(self.evaluator, model, pose.desired[None], pose.root_bone,
+                                          pose.root_location[None])[0]
+            else:  # fallback bones (if any) as the viewport last evaluated them: one frame late
+                pose.quats = model.solve(pose.desired[None], self._evaluated(obj) if model.fallback else None)[0]
         apply_frame_pose(obj, pose)
-        if self.corrector is not None and self.update_after_apply:
-            bpy.context.view_layer.update()  # no viewport redraw to evaluate the constrained parents
+        if self.update_after_apply:
+            bpy.context.view_layer.update()  # no viewport redraw to evaluate the fallback bones
+
+    def release_evaluator(self) -> None:
+        """Remove the armature copy and its scene (stop, and before a save: it must not be saved)."""
+        if self.evaluator is not None:
+            self.evaluator.close()
+            self.evaluator = None
 
     def _evaluated(self, obj) -> dict:
-        """Armature-space rotations of the constrained parents, as Blender last evaluated them (one bulk read)."""
+        """Fallback bones' rotations relative to their parents, as Blender last evaluated the rig."""
         pose_bones = obj.pose.bones
-        if getattr(self, "_pose_index", None) is None or len(pose_bones) != self._pose_count:
-            keys = pose_bones.keys()
-            self._pose_index = np.array([keys.index(name) for _, name in self._read])
-            self._pose_count = len(pose_bones)
-            self._flat = np.empty(self._pose_count * 16, dtype=np.float32)
-        m = read_rotations(pose_bones, self._pose_index, self._flat)
-        return {b: m[k] for k, (b, _) in enumerate(self._read)}
+        if getattr(self, "_pose_index", None) is None or len(pose_bones) != len(self._flat) // 16:
+            where = {n: i for i, n in enumerate(pose_bones.keys())}
+            self._pose_index = np.array([where[n] for n in self.model.rig.bone_names])
+            self._flat = np.empty(len(pose_bones) * 16, dtype=np.float32)
+        rotations = read_rotations(pose_bones, self._pose_index, self._flat)
+        return relative_to_parent(self.model.rig, self.model.fallback, rotations[None])
 
     # -- pumping ---------------------------------------------------------------------------------------------
     def pump(self) -> bool:
@@ -218,6 +231,7 @@ class LiveController:
             bake = self.bake_on_stop()
         session = self.session
         session.stop()
+        self.release_evaluator()
         if self.recording is not None:
             self.stop_recording(bake=bake, context=context)
         obj = self.obj()
@@ -589,6 +603,13 @@ class KINECT_RETARGET_OT_calibrate(bpy.types.Operator):
 
 
 @persistent
+def _on_save_pre(*_args) -> None:
+    # the armature copy of Exact on Constrained Rigs must not be saved: it comes back on the next frame
+    if _controller is not None:
+        _controller.release_evaluator()
+
+
+@persistent
 def _on_load_pre(*_args) -> None:
     # the scene is about to be replaced: end the thread, keep the recording file, bake nothing
     stop_live(bake=False)
@@ -597,12 +618,16 @@ def _on_load_pre(*_args) -> None:
 def register_extra() -> None:
     if _on_load_pre not in bpy.app.handlers.load_pre:
         bpy.app.handlers.load_pre.append(_on_load_pre)
+    if _on_save_pre not in bpy.app.handlers.save_pre:
+        bpy.app.handlers.save_pre.append(_on_save_pre)
 
 
 def unregister_extra() -> None:
     stop_live(bake=False)
     if _on_load_pre in bpy.app.handlers.load_pre:
         bpy.app.handlers.load_pre.remove(_on_load_pre)
+    if _on_save_pre in bpy.app.handlers.save_pre:
+        bpy.app.handlers.save_pre.remove(_on_save_pre)
     if bpy.app.timers.is_registered(_timer):
         bpy.app.timers.unregister(_timer)
 

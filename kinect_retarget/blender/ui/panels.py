@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import bpy
 
+from ..io.armature_probe import fallback_bones
 from ..live import live_controller
 from .bake_settings import draw_bake_options
 from .properties import target_armature
@@ -142,7 +143,9 @@ class KINECT_RETARGET_PT_options(_KinectPanel, bpy.types.Panel):
         col.prop(s, "filter")
         col.prop(s, "root")
         col.prop(s, "mirror")
-        col.prop(s, "exact_constrained")
+        obj = target_armature(context)
+        if obj is not None and fallback_bones(obj.name):  # only a rig with bones no relation explains needs it
+            col.prop(s, "exact_constrained")
         col = layout.column(heading="Recording")
         col.prop(s, "record_dir")
         col.prop(s, "play_on_record")

@@ -48,9 +48,9 @@ class KinectRetargetSettings(bpy.types.PropertyGroup, BakeOptionProps):
     mirror: BoolProperty(name="Mirror", default=False, description="Swap the performer's left and right")
     exact_constrained: BoolProperty(
         name="Exact on Constrained Rigs", default=False,
-        description="On rigs whose bones hang from constraint-driven parents (Rigify), correct every live pose "
-                    "through Blender's evaluation as the bake does, so live equals the baked pose; costs a few "
-                    "Blender evaluations per frame")
+        description="On rigs with constraint-driven parents no learned relation explains (shown only for "
+                    "those), evaluate them on a copy of the armature every live frame as the bake does, so live "
+                    "equals the baked pose; costs a few evaluations of the armature per frame")
     record_dir: StringProperty(name="Folder", subtype="DIR_PATH", default="//kinect_takes/")
     play_on_record: BoolProperty(name="Play Timeline", default=True,
                                  description="Start timeline playback when recording starts (keeps audio in sync)")
