@@ -67,11 +67,13 @@ def bind_body(bpy, rig) -> None:
 
 def bake_once(path: str | None, take_path: str) -> tuple[float, float, str]:
     """Wall and CPU seconds of one bake (the file is open already; the take is read inside the timing)."""
-    import bpy
+    import bpy  # noqa: I001 (addon_utils needs bpy first)
+    import addon_utils
     from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
     if path is None:
         bpy.ops.wm.read_factory_settings(use_empty=True)
     else:
+        addon_utils.enable("rigify", default_set=True)  # its load handlers expect its properties
         bpy.ops.wm.open_mainfile(filepath=path)
     notes = []
     t0, c0 = time.perf_counter(), time.process_time()

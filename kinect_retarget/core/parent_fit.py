@@ -130,8 +130,9 @@ def relative_to_parent(rig: TargetRig, bones, evaluated: np.ndarray) -> dict:
 
 def check(model: ParentModel, sample_basis: np.ndarray, evaluated: np.ndarray) -> float:
     """Worst angle, degrees, between the whole model run forward from the mapped bones' pose rotations and
-    Blender's rotations, over every bone the model covers (fallback bones take Blender's values)."""
+    Blender's rotations, over every bone that matters (fallback bones take Blender's values; plain bones
+    in between were each checked by learn)."""
     rel = relative_to_parent(model.rig, model.fallback, evaluated)
     rotations, _ = model.run(len(sample_basis), basis=sample_basis, evaluated=rel)
-    worst = max(float(angle_between(rotations[b], evaluated[:, b]).max()) for b in model.order)
+    worst = max(float(angle_between(rotations[b], evaluated[:, b]).max()) for b in rotations)
     return float(np.degrees(worst))

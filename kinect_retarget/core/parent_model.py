@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .quat import conjugate, from_matrix, mul, normalize
+from .quat import conjugate, from_matrix, mul, normalize, to_matrix
 from .target_rig import TargetRig
 
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
@@ -60,7 +60,7 @@ def local_rotations(rig: TargetRig, basis: np.ndarray) -> np.ndarray:
     rel = rot.copy()
     has = (rig.parents >= 0) & rig.inherit_rotation
     rel[has] = np.swapaxes(rot[rig.parents[has]], -1, -2) @ rot[has]
-    return mul(from_matrix(rel), basis)
+    return normalize(mul(from_matrix(rel), basis))  # rest matrices come as float32: exactly unit here
 
 
 @dataclass
@@ -88,47 +88,74 @@ class ParentModel:
     def learned_names(self) -> list[str]:
         return [self.rig.bone_names[b] for b in self.follows]
 
-    def _base(self, rotations: dict, b: int, nframes: int) -> np.ndarray | None:
-        p = int(self.rig.parents[b])
-        if p < 0 or not self.rig.inherit_rotation[b]:
-            return None
-        return rotations[p] if p in rotations else np.broadcast_to(IDENTITY, (nframes, 4))
+    def _plan(self) -> list[tuple[int, int, np.ndarray | None]]:
+        """The bones whose rotation matters (mapped, constrained, followed), each as (bone, anchor, C):
+        its parent's rotation is R_anchor · C (anchor -1: C alone; C None: identity), as 3x3 matrices. Plain
+        bones in between fold into C, so a frame costs a few matrix products per bone that matters."""
+        if self.notes.get("plan") is None:
+            key = set(self.mapped) | set(self.follows) | set(self.fallback) | \
+                {f.target for f in self.follows.values() if f.target >= 0}
+            local = to_matrix(normalize(self.local))
+            carry, plan = {}, []
+            for b in self.order:
+                p = int(self.rig.parents[b])
+                if p < 0 or not self.rig.inherit_rotation[b]:
+                    anchor, c = -1, None
+                elif p in key:
+                    anchor, c = p, None
+                else:
+                    anchor, c = carry[p]
+                if b in key:
+                    plan.append((b, anchor, c))
+                else:
+                    carry[b] = (anchor, local[b] if c is None else c @ local[b])
+            self.notes["plan"] = plan
+            self.notes["local_m"] = local
+            self.notes["offset_m"] = {b: to_matrix(normalize(f.offset)) for b, f in self.follows.items()}
+        return self.notes["plan"]
 
     def run(self, nframes: int, desired: np.ndarray | None = None, basis: np.ndarray | None = None,
-            evaluated: dict | None = None) -> tuple[dict, np.ndarray]:
-        """Armature-space rotations of every bone in `order` (bone -> (F, 4)) and the mapped bones' pose
-        quaternions (F, M, 4). Give either `desired` (F, M, 4) armature-space rotations of the mapped bones
-        (the bake and live) or their pose rotations `basis` (F, M, 4) (checking against Blender).
-        evaluated: fallback bone -> (F, 4) rotation relative to its parent, from Blender."""
+            evaluated: dict | None = None, rotations: bool = True) -> tuple[dict, np.ndarray]:
+        """Armature-space rotations (F, 4) of the bones that matter (mapped, constrained, followed; with
+        `rotations`) and the mapped bones' pose quaternions (F, M, 4). Give either `desired` (F, M, 4)
+        armature-space rotations of the mapped bones (the bake and live) or their pose rotations `basis`
+        (F, M, 4) (checking against Blender). evaluated: fallback bone -> (F, 4) rotation relative to its
+        parent, from Blender."""
+        plan = self._plan()
+        local, offset = self.notes["local_m"], self.notes["offset_m"]
         slot = {b: k for k, b in enumerate(self.mapped)}
-        rotations: dict[int, np.ndarray] = {}
-        quats = np.empty((nframes, len(self.mapped), 4))
-        for b in self.order:
-            base = self._base(rotations, b, nframes)
-            if b in slot:
-                k = slot[b]
-                if desired is not None:
-                    frame = self.local[b] if base is None else mul(base, self.local[b])
-                    quats[:, k] = mul(conjugate(frame), desired[:, k])
-                else:
-                    quats[:, k] = basis[:, k]
-                own = mul(self.local[b], quats[:, k])
-            elif b in self.fallback:
-                own = evaluated[b] if evaluated is not None and b in evaluated else self.local[b]
+        given = to_matrix(desired if desired is not None else basis)        # (F, M, 3, 3)
+        pose = np.empty_like(given)
+        out: dict[int, np.ndarray] = {}
+        for b, anchor, c in plan:
+            base = c if anchor < 0 else out[anchor] if c is None else out[anchor] @ c
+            k = slot.get(b)
+            if k is not None and desired is not None:
+                frame = local[b] if base is None else base @ local[b]
+                pose[:, k] = np.swapaxes(frame, -1, -2) @ given[:, k]
+                r = given[:, k]           # what the pose rotation was solved for
             else:
-                own = self.local[b]
-            r = np.broadcast_to(own, (nframes, 4)) if base is None else mul(base, own)
+                if k is not None:
+                    pose[:, k] = given[:, k]
+                    own = local[b] @ given[:, k]
+                elif evaluated is not None and b in evaluated:   # a fallback bone, as Blender has it
+                    own = to_matrix(evaluated[b])
+                else:
+                    own = local[b]
+                r = own if base is None else base @ own
             follow = self.follows.get(b)
             if follow is not None:
-                goal = follow.offset if follow.target < 0 else mul(rotations[follow.target], follow.offset)
-                r = slerp_toward(r, np.broadcast_to(goal, r.shape), follow.weight)
-            rotations[b] = normalize(r)
-        return rotations, quats
+                goal = offset[b] if follow.target < 0 else out[follow.target] @ offset[b]
+                rel = from_matrix(np.swapaxes(r, -1, -2) @ goal)  # w >= 0: the shortest way round
+                r = r @ to_matrix(power(rel, follow.weight))
+            out[b] = np.broadcast_to(r, (nframes, 3, 3))
+        quats = from_matrix(pose)
+        return ({b: from_matrix(m) for b, m in out.items()} if rotations else {}), quats
 
     def solve(self, desired: np.ndarray, evaluated: dict | None = None) -> np.ndarray:
         """desired (F, M, 4) armature-space rotations of the mapped bones -> pose quaternions (F, M, 4)."""
         desired = np.asarray(desired, dtype=np.float64)
-        return self.run(desired.shape[0], desired=desired, evaluated=evaluated)[1]
+        return self.run(desired.shape[0], desired=desired, evaluated=evaluated, rotations=False)[1]
 
 
 def dependency_order(rig: TargetRig, roots, targets: dict[int, list[int]]) -> list[int]:
