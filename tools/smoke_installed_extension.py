@@ -91,6 +91,10 @@ def main(argv: list[str] | None = None) -> int:
               and str(side["simulated"]).startswith("rendered") and side.get("stats", {}).get("applied", 0) > 0)
         # the headless command from the installed folder (the depth cache is warm now)
         cli_env = dict(env, PYTHONPATH=str(Path(side["installed"]).parent))
+        code, where, _ = _run([sys.executable, "-c", "import kinect_retarget; print(kinect_retarget.__file__)"],
+                              cli_env, cwd=tmp)
+        print("live --source usb --simulate runs", where.strip())
+        ok = ok and code == 0 and Path(where.strip()).resolve().is_relative_to(Path(side["installed"]).resolve())
         code, out, err = _run([sys.executable, "-m", "kinect_retarget", "live", "--source", "usb", "--simulate",
                                "--seconds", str(args.seconds)], cli_env, cwd=tmp)
         stats = json.loads(out.strip().splitlines()[-1]) if code == 0 and out.strip() else {}

@@ -52,6 +52,11 @@ def test_zip_has_manifest_package_and_every_platforms_wheels(extension_zip):
     package = Path(__file__).resolve().parents[2] / "kinect_retarget"
     every_module = {str(f.relative_to(package)) for f in package.rglob("*.py") if "__pycache__" not in f.parts}
     assert every_module <= names, sorted(every_module - names)   # every subpackage ships
+    # the simulated Kinect's body and motion travel in the zip, with their credits and licences
+    assert {"assets/__init__.py", "assets/CREDITS.md", "assets/makehuman/base.obj", "assets/makehuman/default.mhskel",
+            "assets/makehuman/default_weights.mhw", "assets/makehuman/LICENSE.ASSETS.md", "assets/motion/131_03.bvh",
+            "assets/motion/LICENSE.bvh11.txt"} <= names
+    assert extension_zip.stat().st_size < 20 * 1024 * 1024   # the README states its size (a few MB)
     assert not any("__pycache__" in n for n in names)
     listed = {w.removeprefix("./") for w in manifest["wheels"]}
     assert listed == {n for n in names if n.startswith("wheels/")}
