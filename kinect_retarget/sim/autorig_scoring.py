@@ -1,6 +1,7 @@
-"""Ground truth for checking the auto-rigger on MakeHuman's base mesh (shared data §4a): the reference
-skeleton from default.mhskel, the mesh's own skin weights, and linear blend skinning to pose the mesh from
-MakeHuman's BVH poses or from CMU motions (global bone rotations carried over by bone correspondence)."""
+"""Ground truth for checking the auto-rigger on MakeHuman's base mesh (kinect_retarget/assets/makehuman,
+tests/data/README.md §4a): the reference skeleton from default.mhskel, the mesh's own skin weights, and linear
+blend skinning to pose the mesh from MakeHuman's BVH poses or from CMU motions (global bone rotations carried
+over by bone correspondence)."""
 from __future__ import annotations
 
 import json

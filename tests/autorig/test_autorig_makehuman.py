@@ -1,4 +1,4 @@
-"""The auto-rigger on MakeHuman's base mesh (CC0, shared data §4a) against its reference skeleton."""
+"""The auto-rigger on MakeHuman's base mesh (CC0, tests/data/README.md §4a) against its reference skeleton."""
 import numpy as np
 import pytest
 
