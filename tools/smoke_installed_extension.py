@@ -35,9 +35,9 @@ def _sidebar_child(zip_path: str, seconds: float) -> dict:
     out = {"installed": str(root), "enabled": EXT in bpy.context.preferences.addons}
     assets = importlib.import_module(EXT + ".assets")
     out["assets_in_installed_copy"] = Path(assets.ASSETS_DIR).resolve().is_relative_to(root.resolve())
-    usb_panel = importlib.import_module(EXT + ".blender.usb_panel")
-    live = importlib.import_module(EXT + ".blender.live")
-    kinect_rig = importlib.import_module(EXT + ".blender.kinect_rig")
+    usb_panel = importlib.import_module(EXT + ".blender.live.usb_service")
+    live = importlib.import_module(EXT + ".blender.live.live_controller")
+    kinect_rig = importlib.import_module(EXT + ".blender.io.kinect_rig")
     layout = importlib.import_module(EXT + ".core.kinect_rig_layout")
     skeletons = importlib.import_module(EXT + ".core.skeletons")
 
