@@ -25,6 +25,7 @@ from ...sources import OscReceiver, SourceError, TakePlayback, UsbKinectSource
 from ...takes import load_take
 from ..bake_take import bake_take, make_pipeline, set_scene_rate
 from ..ui.bake_settings import recording_bake_options
+from .undo_step import push_undo_step
 from ..ui.mapping_table import table_overrides
 from ..io.pose_apply import apply_frame_pose, restore_pose, snapshot_pose
 from ..io.armature_probe import ArmatureEvaluator, constrained_summary, probe_parents, read_rotations, solve_frames
@@ -153,7 +154,9 @@ class LiveController:
         self.message = f"Recording to {path}"
         return path
 
-    def stop_recording(self, bake: bool, context=None) -> str | None:
+    def stop_recording(self, bake: bool, context=None, undo_step: bool = True) -> str | None:
+        """Stop recording, keep the take, bake it when asked; the bake is one undo step (pushed here, or by
+        finish() once the rig's pose is restored when `undo_step` is False)."""
         rec, self.recording = self.recording, None
         if rec is None:
             return None
@@ -166,15 +169,15 @@ class LiveController:
             self.post("WARNING", "Recording stopped: no frame was recorded")
             return None
         self.post("INFO", f"Recorded {frames} frames to {path}")
-        if bake:
-            self._bake(path, rec)
+        if bake and self._bake(path, rec) and undo_step:
+            push_undo_step()
         return path
 
-    def _bake(self, path: str, rec: dict) -> None:
+    def _bake(self, path: str, rec: dict) -> bool:
         obj = self.obj()
         if obj is None:
             self.post("WARNING", f"Recording kept in {path}; the armature is gone, nothing was baked")
-            return
+            return False
         pipeline = self.session.pipeline
         n = pipeline.retargeter.scale_for(pipeline.source_leg)  # the root scale live used
         try:
@@ -189,13 +192,14 @@ class LiveController:
                                report=lambda level, msg: self.post(next(iter(level)), msg))
         except (TakeError, ValueError) as exc:
             self.post("ERROR", f"Recording kept in {path} but could not be baked: {exc}")
-            return
+            return False
         self.baked_action = result.action.name
         first, last = result.frame_range
         scene = self.scene()
         if scene is not None and last > scene.frame_end:
             scene.frame_end = last
         self.post("INFO", f"Baked the recording to action {result.action.name!r} (frames {first}-{last})")
+        return True
 
     # -- calibration -----------------------------------------------------------------------------------------
     def calibrate(self, seconds: float = 1.0) -> None:
@@ -232,11 +236,14 @@ class LiveController:
         session = self.session
         session.stop()
         self.release_evaluator()
+        baked_before = self.baked_action
         if self.recording is not None:
-            self.stop_recording(bake=bake, context=context)
+            self.stop_recording(bake=bake, context=context, undo_step=False)
         obj = self.obj()
         if obj is not None:
             _restore_state(obj, self._saved, keep_animation=self.baked_action is not None)
+        if self.baked_action != baked_before:
+            push_undo_step()  # the Action, its assignment and the restored pose: one step
         if session.error:
             self.post("ERROR", f"Live stopped: {session.error}")
         elif not self.message.startswith("Baked"):
