@@ -25,6 +25,7 @@ from ...sources import OscReceiver, SourceError, TakePlayback, UsbKinectSource
 from ...takes import load_take
 from ..bake_take import bake_take, make_pipeline, set_scene_rate
 from ..ui.bake_settings import recording_bake_options
+from .osc_access import osc_host
 from .undo_step import push_undo_step
 from ..ui.mapping_table import table_overrides
 from ..io.pose_apply import apply_frame_pose, restore_pose, snapshot_pose
@@ -340,8 +341,9 @@ def make_source(settings, prefs):
         return TakePlayback(bpy.path.abspath(settings.take_path), speed=settings.speed, loop=settings.loop), \
             f"take {os.path.basename(settings.take_path)}"
     if settings.source == "OSC":
-        host = "0.0.0.0" if prefs is not None and prefs.osc_listen_all else "127.0.0.1"
-        return OscReceiver(settings.osc_port, host=host), f"OSC port {settings.osc_port}"
+        host, refused = osc_host(prefs)
+        return OscReceiver(settings.osc_port, host=host), \
+            f"OSC port {settings.osc_port}" + (" (this computer only: online access is off)" if refused else "")
     if usb_source_factory is not None:
         return usb_source_factory(settings, prefs)
     return UsbKinectSource(), "USB Kinect"

@@ -5,7 +5,9 @@ import bpy
 
 from ..io.armature_probe import fallback_bones
 from ..live import live_controller
+from ..live.osc_access import osc_host
 from .bake_settings import draw_bake_options
+from .preferences import get_preferences
 from .properties import target_armature
 
 
@@ -40,6 +42,9 @@ class KINECT_RETARGET_PT_main(_KinectPanel, bpy.types.Panel):
             row.prop(s, "loop", toggle=True)
         elif s.source == "OSC":
             col.prop(s, "osc_port")
+            refused = osc_host(get_preferences(context))[1]
+            if refused:
+                col.label(text=refused, icon="INTERNET_OFFLINE")
         else:
             col.label(text=_usb_status(), icon="INFO")
         self._draw_status(box, st)

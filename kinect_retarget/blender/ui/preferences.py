@@ -25,7 +25,8 @@ class KinectRetargetPreferences(bpy.types.AddonPreferences):
                           description="UDP port NI mate (or another bridge) sends skeleton messages to")
     osc_listen_all: BoolProperty(
         name="Listen on All Interfaces", default=False,
-        description="Accept OSC from other machines (binds 0.0.0.0). Off: only this computer (127.0.0.1)")
+        description="Accept OSC from other machines (binds 0.0.0.0), only while Blender's Allow Online Access is "
+                    "on. Off: only this computer (127.0.0.1)")
     default_filter: EnumProperty(name="Default Filter", items=FILTER_ITEMS, default="default")
     recordings_dir: StringProperty(name="Recordings Folder", subtype="DIR_PATH", default="//kinect_takes/",
                                    description="Where live recordings (.krtake) are written; // is the .blend's folder")
@@ -40,6 +41,9 @@ class KinectRetargetPreferences(bpy.types.AddonPreferences):
         col.prop(self, "default_source")
         col.prop(self, "osc_port")
         col.prop(self, "osc_listen_all")
+        if self.osc_listen_all and not bpy.app.online_access:
+            col.label(text="Allow Online Access is off (System > Network): OSC stays on this computer",
+                      icon="INTERNET_OFFLINE")
         col.prop(self, "default_filter")
         col.prop(self, "recordings_dir")
         col.prop(self, "lost_tracking_timeout")
