@@ -221,7 +221,7 @@ class EmulatedKinect(usb.backend.IBackend):
             self._update_plug()
             if self._generation < 0 or dev not in self.functions:
                 self._no_device()
-            if self.faults.access_denied:
+            if self.faults.access_denied or dev.kind in self.faults.denied:
                 raise USBError("Access denied (insufficient permissions)", LIBUSB_ERROR_ACCESS, errno.EACCES)
             handle = _Handle(dev, self._generation)
             self._handles[handle.id] = handle

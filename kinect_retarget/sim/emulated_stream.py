@@ -28,6 +28,7 @@ class Faults:
     unplug_at: float | None = None             # seconds after the first depth start
     replug_at: float | None = None
     access_denied: bool = False                # open() fails as without a udev rule
+    denied: tuple[str, ...] = ()               # only these devices ("camera", "motor", "audio") refuse to open
     seed: int = 0
     # --- what real hosts and devices do (libfreenect issues in docs/usb_driver.md) ---
     unplug_cancels: bool = False               # on unplug transfers come back CANCELLED (libusb on macOS)
