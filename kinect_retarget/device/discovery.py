@@ -29,9 +29,9 @@ def udev_rule_install_command() -> str:
 MOTOR_FIRMWARE_NOTE = ("tilt, LED and accelerometer on this model go through the audio chip and only work after "
                        "its proprietary firmware (audios.bin) has been uploaded to it. That file is not included "
                        "and may not be redistributed: libfreenect's src/fwfetcher.py extracts it from a "
-                       "Microsoft Xbox 360 system update; put it in ~/.libfreenect/ and open the Kinect with "
-                       "libfreenect once (or the Kinect SDK on Windows), which uploads it until the next unplug. "
-                       "Depth streaming works without it.")
+                       "Microsoft Xbox 360 system update. Put it in ~/.libfreenect/ (or the folder named by "
+                       "LIBFREENECT_FIRMWARE_PATH) and the tilt, led and accel commands upload it themselves, as "
+                       "libfreenect does; it stays until the Kinect loses power. Depth streaming works without it.")
 
 
 @dataclass
@@ -49,6 +49,11 @@ class KinectInfo:
     motor: object = field(default=None, repr=False)    # usb.core.Device (1414) or audio device (others)
     audio: object = field(default=None, repr=False)    # usb.core.Device of the audio chip, if found
     matched: dict = field(default_factory=dict)        # how motor and audio were paired with the camera
+
+    @property
+    def needs_audio_firmware(self) -> bool:
+        """The motor goes through an audio chip that is reachable but still in its bootloader."""
+        return not self.motor_available and self.motor_note == MOTOR_FIRMWARE_NOTE
 
     def describe(self) -> str:
         lines = [f"{self.model}  serial {self.serial}  (bus {self.bus}, address {self.address})",

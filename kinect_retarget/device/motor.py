@@ -18,7 +18,8 @@ import usb.util
 from . import protocol as P
 from .kinect_camera import access_advice, is_gone
 from .discovery import KinectInfo, find_kinect
-from .errors import AccessDenied, DeviceGone, MotorUnavailable, ProtocolError
+from .audio_firmware import boot_audio_chip, find_firmware
+from .errors import AccessDenied, BadInputFile, DeviceGone, KinectError, MotorUnavailable, ProtocolError
 
 log = logging.getLogger(__name__)
 
@@ -159,7 +160,17 @@ class KinectMotor:
 
 
 def open_motor(backend=None, serial: str | None = None) -> KinectMotor:
-    return KinectMotor(find_kinect(backend, serial))
+    """The motor of the (first) Kinect. On a 1473 / Kinect for Windows whose audio chip is still in its
+    bootloader, audios.bin is uploaded first when it can be found (as libfreenect does)."""
+    info = find_kinect(backend, serial)
+    if info.needs_audio_firmware and find_firmware() is not None:
+        try:
+            info = boot_audio_chip(info, lambda s: find_kinect(backend, s))
+        except BadInputFile:
+            raise                         # the user's file: their input, named in the message
+        except KinectError as exc:
+            raise MotorUnavailable(f"{info.model} {info.serial}: {exc}") from exc
+    return KinectMotor(info)
 
 
 def set_tilt(angle: float, backend=None, serial: str | None = None) -> float:

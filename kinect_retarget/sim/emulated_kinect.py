@@ -1,10 +1,11 @@
-"""An emulated Kinect v1, as a pyusb backend (usb.backend.IBackend).
+"""An emulated Kinect v1, as a pyusb backend (usb.backend.IBackend) with its own emulated libusb.
 
 It enumerates the camera (and, for the 1414, the motor; for the 1473 and Kinect for Windows, the audio
 chip) with real descriptors (emulated_usb.py), answers the GM/RB command protocol with register state, stalls on
-malformed commands as the device's control pipe would, drives a tilt motor with an accelerometer (emulated_motor.py), and
-streams depth built from a sequence of depth images through the iso seam (emulated_stream.py), with fault
-injection. The driver runs unchanged against it: only the iso seam has an emulated implementation.
+malformed commands as the device's control pipe would, drives a tilt motor with an accelerometer
+(emulated_motor.py), takes the audio firmware (emulated_audio.py), and streams depth built from a sequence of
+depth images through its libusb's asynchronous transfers (emulated_libusb.py, emulated_stream.py), with the
+faults real devices and hosts show (Faults). The driver runs unchanged against it, down to its iso pump.
 """
 from __future__ import annotations
 
@@ -14,7 +15,6 @@ import itertools
 import struct
 import threading
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 import usb.backend
@@ -23,9 +23,10 @@ from usb.core import USBError
 from ..device import protocol as P
 from ..device.depth_unpack import pack_11bit
 from .emulated_motor import EmulatedMotor, Rejected
+from .emulated_audio import AudioBootloader
 from .emulated_libusb import EmulatedLibusb
-from .emulated_stream import DepthPacketizer, FaultyWire, Faults, VirtualClock
-from .emulated_usb import UsbFunction, build_functions, calibration_reply
+from .emulated_stream import DepthPacketizer, DepthStreamState, FaultyWire, Faults, VirtualClock
+from .emulated_usb import EmulatedHandle, UsbFunction, build_functions, calibration_reply
 from ..device.protocol import TICKS_PER_FRAME
 from ..device.usb_backend import LIBUSB_ERROR_NO_DEVICE
 
@@ -35,33 +36,6 @@ LIBUSB_ERROR_TIMEOUT = -7
 LIBUSB_ERROR_IO = -1
 DEFAULT_SERIAL = "A00366A08793039A"
 REENUMERATE_S = 2.0     # a 1473 without the LED keep-alive drops off the bus this long after its camera opens
-
-
-_handle_ids = itertools.count(1)
-
-
-@dataclass
-class _Handle:
-    function: UsbFunction
-    generation: int
-    claimed: set = field(default_factory=set)
-    alt: dict = field(default_factory=dict)
-    id: int = field(default_factory=lambda: next(_handle_ids))
-
-    @property
-    def handle(self) -> int:          # what libusb's transfers carry as dev_handle (see emulated_libusb.py)
-        return self.id
-
-    @property
-    def devid(self) -> UsbFunction:
-        return self.function
-
-
-@dataclass
-class _DepthStreamState:
-    id: int
-    start_time: float
-    packetizer: DepthPacketizer
 
 
 class EmulatedKinect(usb.backend.IBackend):
@@ -97,11 +71,13 @@ class EmulatedKinect(usb.backend.IBackend):
         self._stream_ids = itertools.count(1)
         self._first_start: float | None = None
         self._manual_plugged = True
+        self.serial, self.topology, self._audio_firmware = serial, topology, audio_firmware
         self.functions = build_functions(model, serial, audio_firmware, topology)
+        self.firmware_uploads = 0
         self._bulk_replies: list[bytes] = []
         self._assign_addresses()
         self._power_on()
-        self._handles: dict[int, _Handle] = {}
+        self._handles: dict[int, EmulatedHandle] = {}
         self._wire = FaultyWire(self.faults)
         self.lib = EmulatedLibusb(self)         # its libusb: the driver's LibusbIsoPump streams through it
         self.ctx = None
@@ -127,10 +103,11 @@ class EmulatedKinect(usb.backend.IBackend):
 
     def _power_on(self) -> None:
         self.registers: dict[int, int] = {}
-        self.depth_stream: _DepthStreamState | None = None
+        self.depth_stream: DepthStreamState | None = None
         self._pending_reply: bytes | None = None
         self._reply_delay = 0
         self.motor = EmulatedMotor(self.clock)
+        self.bootloader = AudioBootloader()
         self.keep_alive_received = False
         self._camera_opened_at: float | None = None
 
@@ -170,6 +147,9 @@ class EmulatedKinect(usb.backend.IBackend):
             self._generation = -(self._generation + 1)       # negative: unplugged
         elif plugged and self._generation < 0:
             self._generation = -self._generation
+            # power lost: an uploaded audio firmware is gone (one the constructor was given stands for a
+            # host whose driver uploads it at every plug, as the Kinect SDK does)
+            self.functions = build_functions(self.model, self.serial, self._audio_firmware, self.topology)
             self._assign_addresses()
             self._power_on()
 
@@ -179,20 +159,24 @@ class EmulatedKinect(usb.backend.IBackend):
             self._update_plug()
             return self._generation >= 0
 
-    def handle_by_id(self, handle_id) -> _Handle | None:
+    def handle_by_id(self, handle_id) -> EmulatedHandle | None:
         return self._handles.get(handle_id)
 
-    def handle_alive(self, handle: _Handle | None) -> bool:
-        return handle is not None and self.refresh_plug() and handle.generation == self._generation
+    def handle_alive(self, handle: EmulatedHandle | None) -> bool:
+        return (handle is not None and self.refresh_plug() and handle.generation == self._generation
+                and self._enumerated(handle.function))
 
-    def wire_packet(self, stream: "_DepthStreamState", index: int) -> bytes | None:
+    def _enumerated(self, function: UsbFunction) -> bool:
+        return any(fn is function for fn in self.functions)     # a re-enumerated device is a new one
+
+    def wire_packet(self, stream: "DepthStreamState", index: int) -> bytes | None:
         """Packet `index` of a depth stream as it reaches the host: None if the wire lost it."""
         return self._wire.packet(stream.packetizer, index)
 
-    def check_handle(self, handle: _Handle) -> None:
+    def check_handle(self, handle: EmulatedHandle) -> None:
         with self._lock:
             self._update_plug()
-            if handle.generation != self._generation:
+            if handle.generation != self._generation or not self._enumerated(handle.function):
                 self._no_device()
 
     # --- IBackend: enumeration and descriptors -----------------------------------------------------------
@@ -219,11 +203,11 @@ class EmulatedKinect(usb.backend.IBackend):
     def open_device(self, dev):
         with self._lock:
             self._update_plug()
-            if self._generation < 0 or dev not in self.functions:
+            if self._generation < 0 or not self._enumerated(dev):
                 self._no_device()
             if self.faults.access_denied or dev.kind in self.faults.denied:
                 raise USBError("Access denied (insufficient permissions)", LIBUSB_ERROR_ACCESS, errno.EACCES)
-            handle = _Handle(dev, self._generation)
+            handle = EmulatedHandle(dev, self._generation)
             self._handles[handle.id] = handle
             return handle
 
@@ -355,7 +339,7 @@ class EmulatedKinect(usb.backend.IBackend):
             sid = next(self._stream_ids)
             seq0 = (sid * 97) & 0xFF                     # streams do not restart at sequence 0
             packetizer = DepthPacketizer(self.images, seq0, sid * 12_345_678, packed=self._packed)
-            self.depth_stream = _DepthStreamState(sid, now, packetizer)
+            self.depth_stream = DepthStreamState(sid, now, packetizer)
             self.streams.append(packetizer)
 
     def _motor_control(self, rtype, request, value, data) -> int:
@@ -372,13 +356,15 @@ class EmulatedKinect(usb.backend.IBackend):
             fn = dev_handle.function
             if fn.kind != "audio" or ep != 0x01:
                 self._stall()
-            try:
-                # the bootloader (no firmware) takes the LED command only: libfreenect's keep-alive
-                replies = self.motor.audio_command(bytes(data), firmware=len(fn.interfaces) >= 2)
+            firmware = len(fn.interfaces) >= 2
+            replies = None if firmware else self.bootloader.command(bytes(data))
+            if replies is None:
+                try:   # the bootloader takes the LED command only: libfreenect's keep-alive
+                    replies = self.motor.audio_command(bytes(data), firmware=firmware)
+                except Rejected:
+                    self._stall()
                 self.keep_alive_received = True
-                self._bulk_replies += replies
-            except Rejected:
-                self._stall()
+            self._bulk_replies += replies
             return len(data)
 
     def bulk_read(self, dev_handle, ep, intf, buff, timeout):
@@ -386,4 +372,16 @@ class EmulatedKinect(usb.backend.IBackend):
             self.check_handle(dev_handle)
             if ep != 0x81 or not self._bulk_replies:
                 raise USBError("Operation timed out", LIBUSB_ERROR_TIMEOUT, errno.ETIMEDOUT)
-            return self._fill(buff, self._bulk_replies.pop(0))
+            n = self._fill(buff, self._bulk_replies.pop(0))
+            if self.bootloader.booted and not self._bulk_replies:
+                self._audio_firmware_starts()
+            return n
+
+    def _audio_firmware_starts(self) -> None:
+        """The uploaded firmware runs: the audio chip leaves the bus and comes back with it (and, on a Kinect
+        for Windows, another product id); the camera and motor stay as they are."""
+        self.bootloader = AudioBootloader()
+        new = next(fn for fn in build_functions(self.model, self.serial, True, self.topology) if fn.kind == "audio")
+        new.address = next(self._addresses)
+        self.functions = [new if fn.kind == "audio" else fn for fn in self.functions]
+        self.firmware_uploads += 1

@@ -70,6 +70,14 @@ class DepthPacketizer:
         return header + data[start:start + size]
 
 
+@dataclass
+class DepthStreamState:
+    """The depth stream the device is sending: started by register 0x06 = 2, ended by 0x06 = 0."""
+    id: int
+    start_time: float
+    packetizer: DepthPacketizer
+
+
 def packet_due_time(index: int) -> float:
     """Seconds after stream start at which packet `index` reaches the host."""
     frame, j = divmod(index, DEPTH_PACKETS_PER_FRAME)

@@ -2,8 +2,9 @@
 the calibration its camera answers with."""
 from __future__ import annotations
 
+import itertools
 import struct
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..device import protocol as P
 
@@ -60,6 +61,27 @@ class UsbFunction:
 
     def strings(self) -> dict[int, str]:
         return {1: "Microsoft", 2: self.product, 3: self.serial or ""}
+
+
+_handle_ids = itertools.count(1)
+
+
+@dataclass
+class EmulatedHandle:
+    """An open device handle; dead once its device leaves the bus (generation) or re-enumerates."""
+    function: UsbFunction
+    generation: int
+    claimed: set = field(default_factory=set)
+    alt: dict = field(default_factory=dict)
+    id: int = field(default_factory=lambda: next(_handle_ids))
+
+    @property
+    def handle(self) -> int:          # what libusb's transfers carry as dev_handle (see emulated_libusb.py)
+        return self.id
+
+    @property
+    def devid(self) -> UsbFunction:
+        return self.function
 
 
 def build_functions(model: str, serial: str, audio_firmware: bool, topology: str = "hub") -> list[UsbFunction]:
