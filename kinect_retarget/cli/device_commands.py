@@ -28,6 +28,9 @@ def add_parsers(sub) -> None:
     p = sub.add_parser("devices", help="list connected Kinects and what keeps them from working")
     p.add_argument("--udev-rule", action="store_true", help="print the Linux udev rule (and how to install it)")
     p.add_argument("--json", action="store_true", help="one JSON object per Kinect")
+    p.add_argument("--diagnose", action="store_true",
+                   help="report for a bug report: what is on each bus, what was tried and what answered "
+                        "(opens each Kinect and streams for up to 3 s)")
     _add_simulate(p)
     p.set_defaults(handler=run_devices)
 
@@ -81,6 +84,10 @@ def run_devices(args) -> int:
     from ..device.discovery import UDEV_RULES, UDEV_RULES_PATH, list_devices, udev_rule_install_command
     if args.udev_rule:
         print(f"# {UDEV_RULES_PATH}\n{UDEV_RULES}\n# install it with:\n{udev_rule_install_command()}")
+        return 0
+    if args.diagnose:
+        from ..device.diagnosis import diagnose
+        print(diagnose(_backend(args)))
         return 0
     kinects = list_devices(_backend(args))
     if args.json:

@@ -200,8 +200,9 @@ class KinectCamera:
         if payload != b"\x00\x00":
             # libfreenect only warns: real devices have answered 4 bytes (its issue #598) and work
             self.odd_write_acks.append((reg, payload.hex()))
-            log.warning("register %#x write answered %s instead of 0000; going on, as libfreenect does",
-                        reg, payload.hex() or "nothing")
+            if len(self.odd_write_acks) == 1:                 # once per opened camera
+                log.warning("register %#x write answered %s instead of 0000; going on, as libfreenect does",
+                            reg, payload.hex() or "nothing")
 
     def read_calibration(self) -> Calibration:
         fixed = self.command(P.OP_FIXED_PARAMS, P.words(0, 0, 0, 0, 0))
