@@ -64,7 +64,8 @@ def bench_decode(images, n_frames: int) -> float:
 
 
 def emulator_cost_per_second(images) -> float:
-    """CPU seconds the emulated device spends producing one second of depth packets."""
+    """CPU seconds the emulated device and the iso pump (the driver's LibusbIsoPump on the emulated libusb,
+    callbacks and packet copies included) spend on one second of depth packets."""
     clock = VirtualClock()
     emu = EmulatedKinect(images, clock=clock)
     from kinect_retarget.device.kinect_camera import KinectCamera
@@ -105,8 +106,8 @@ def bench_stream(images, seconds: float) -> None:
     print(f"  frames received {got} ({got / wall:.1f} fps), dropped {status.frames_dropped}, "
           f"packets lost {status.packets_lost}, queue overflows {status.queue_overflows}")
     print(f"  streaming thread CPU share: {share * 100:.1f} % of one core "
-          f"(of which the emulator producing packets: {emu_share * 100:.1f} %; "
-          f"driver alone about {(share - emu_share) * 100:.1f} %)")
+          f"(of which the emulated device with the driver's iso pump: {emu_share * 100:.1f} %; "
+          f"reassembly, decode and queueing about {(share - emu_share) * 100:.1f} %)")
 
 
 def bench_stop(images, trials: int = 15) -> None:
