@@ -35,7 +35,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .skeletons import KINECT_V1, V1_FROM_V2
+from .skeletons import KINECT_V1
+from .structure_names import kinect_names, name_side
 
 ROLES = KINECT_V1.joints
 SHORT = 0.03        # a segment shorter than this fraction of the figure's size is a zero-length helper
@@ -46,19 +47,6 @@ ARM_BRANCH = 0.2    # and the two arms at least this much (breasts and other hel
 STILL_DEG = 0.5     # a node whose chain never bends more than this over the take is a twist node
 TWIST_NAME = re.compile(r"twist|roll|upperarm0?2|lowerarm0?2|upperleg0?2|lowerleg0?2|helper|adjust|share",
                         re.I)
-
-
-def name_side(name: str) -> int:
-    """+1 if a node name says left ('LeftArm', 'thigh.L', 'l_hip', 'lShldr', 'LHipJoint'), -1 right, 0 neither."""
-    low = name.lower()
-    for word, side in (("left", 1), ("right", -1)):
-        if word in low:
-            return side
-    tokens = re.split(r"[^a-z]+", low)
-    for letter, side in (("l", 1), ("r", -1)):
-        if letter in tokens or re.match(rf"[{letter}{letter.upper()}][A-Z]", name):
-            return side
-    return 0
 
 
 class StructureError(ValueError):
@@ -291,7 +279,7 @@ class _Mapper:
         if side[0] < side[1]:
             arm_a, arm_b = arm_b, arm_a
         roles = self._roles(pelvis, chest, spine, head_chain, top, arm_a, arm_b, leg_a, leg_b)
-        roles = self._kinect_names(roles)
+        roles = kinect_names(self.names, self.ends, roles, self.notes)
         return StructureMapping(roles, up_axis, up_sign, forward, top, leg_a["feet"] + leg_b["feet"], self.notes)
 
     def _up(self, top: int, leg_a: dict, leg_b: dict) -> tuple[int, float]:
@@ -374,27 +362,3 @@ class _Mapper:
                 "end site after the ankle" if self.ends[f] else "toe joint after the ankle")
             roles["Foot" + side] = RoleMatch(f, (f,) if f is not None else (), how)
         return {r: roles[r] for r in ROLES}
-
-    def _kinect_names(self, roles: dict[str, RoleMatch]) -> dict[str, RoleMatch]:
-        """A Kinect-named skeleton (v1 or v2 joint names) maps one to one wherever it names the joint."""
-        index = {n.lower(): i for i, n in enumerate(self.names) if not self.ends[i]}
-        found = {}
-        for role in ROLES:
-            for name in (role, V1_FROM_V2.get(role, role)):
-                if name.lower() in index:
-                    found[role] = index[name.lower()]
-                    break
-        if len(found) < 10:
-            return roles
-        out = dict(roles)
-        pairs = [(r, r.replace("Left", "Right")) for r in ROLES if "Left" in r]
-        if any(found.get(a) in roles[b].average for a, b in pairs):  # the names put left where we saw right
-            self.notes.append("left and right follow the Kinect joint names")
-            for a, b in pairs:
-                out[a], out[b] = roles[b], roles[a]
-        for role, j in found.items():
-            if out[role].node not in (None, j) and j not in out[role].average:
-                self.notes.append(f"{role}: the Kinect name {self.names[j]!r} overrides the structure's "
-                                  f"{self.names[out[role].node]!r}")
-            out[role] = RoleMatch(j, (j,), "Kinect name")
-        return out

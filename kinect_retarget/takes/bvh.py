@@ -96,7 +96,7 @@ def read_bvh_skeleton(path: str | os.PathLike, scale: float | None = None) -> Bv
     else:
         motion.mapping = motion.structure.indices()
         motion.up_axis, motion.up_sign = motion.structure.up_axis, motion.structure.up_sign
-        motion.height_units = standing_height(positions, motion.structure)
+        motion.height_units = standing_height(positions, motion.structure, sk.parents)
     motion.units_to_metres, motion.notes["units"] = choose_unit(motion.height_units, motion.family, scale, path)
     warning = height_warning(motion.height_units * motion.units_to_metres, motion.notes["units"])
     if warning and motion.structure is not None:

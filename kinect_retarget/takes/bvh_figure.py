@@ -4,8 +4,7 @@
 * up: the lab axis along which the head stays furthest above the feet over the take (not the rest offsets,
   which exporters such as Rokoko or Bandai-Namco write along each bone's own X);
 * unit: the one among metres, decimetres, CMU units, inches, centimetres and millimetres that makes the
-  figure's standing height (top of the head to the lowest foot point, 90th percentile over the take) closest
-  to 1.7 m; a CMU-named skeleton keeps CMU units when they give a plausible height. A figure still outside
+  figure's height (standing_height) closest to 1.7 m; a CMU-named skeleton keeps CMU units when they give a plausible height. A figure still outside
   1.0-2.3 m after the guess is read with a warning that names its height.
 """
 from __future__ import annotations
@@ -40,12 +39,25 @@ def map_figure(path: str, names, parents, rest, positions, ends) -> StructureMap
                         f"(its joints: {shown}...)") from None
 
 
-def standing_height(positions: np.ndarray, structure: StructureMapping) -> float:
-    """Top of the head above the lowest foot point, in file units (90th percentile over the frames)."""
+def standing_height(positions: np.ndarray, structure: StructureMapping, parents: np.ndarray) -> float:
+    """The figure's height in file units: the taller of how tall it stands over the take (top of the head above
+    the lowest foot point, 90th percentile) and its bone chain from the top of the head down the spine and a
+    leg to the ankle, stretched out (so a take that only crouches, sits or lies is not taken for a child)."""
     up = structure.up
     top = positions[:, structure.top] @ up
     low = (positions[:, list(structure.feet)] @ up).min(axis=1)
-    return float(np.nanpercentile(top - low, 90))
+    posed = float(np.nanpercentile(top - low, 90))
+
+    def bone(a: int, b: int) -> float:
+        return float(np.nanmedian(np.linalg.norm(positions[:, a] - positions[:, b], axis=-1)))
+
+    pelvis, j, chain = structure.roles["HipCenter"].node, structure.top, 0.0
+    while j != pelvis and parents[j] >= 0:
+        chain, j = chain + bone(j, parents[j]), int(parents[j])
+    node = {r: m.node for r, m in structure.roles.items()}
+    legs = [bone(node[f"Hip{s}"], node[f"Knee{s}"]) + bone(node[f"Knee{s}"], node[f"Ankle{s}"])
+            for s in ("Left", "Right")]
+    return max(posed, chain + float(np.mean(legs)))
 
 
 def choose_unit(height_units: float, family: str | None, scale: float | None, path: str) -> tuple[float, str]:

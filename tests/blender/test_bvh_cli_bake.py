@@ -54,7 +54,27 @@ def test_cli_bake_of_a_z_up_millimetre_bvh_stands_upright(bpy_empty, tmp_path):
 def test_cli_bake_scale_override_and_odd_size_warning(tmp_path):
     r, out = _bake(tmp_path, "--scale", "0.01")
     assert r.returncode == 0, r.stderr
-    assert "warning: the figure is 14.64 m tall with the unit 0.01 m per unit (given)" in r.stderr
+    assert "warning: the figure is 15.45 m tall with the unit 0.01 m per unit (given)" in r.stderr
     bad = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(BVH), "--out",
                           str(tmp_path / "x.blend"), "--scale", "-2"], capture_output=True, text=True)
     assert bad.returncode == 2 and "scale must be a positive number" in bad.stderr
+
+
+def test_blender_bvh_export_reads_back_as_the_same_figure(tmp_path):
+    """Blender's own BVH exporter (Z up, metres, full local translations on every joint, bones named after
+    their tail joint) through `bake --out x.bvh`, read back: the same limbs as the source."""
+    from kinect_retarget.takes import bvh
+    from tests.takes import baked_figure
+    src = BVH.parent / "mocapbank_walk.bvh"
+    out = tmp_path / "exported.bvh"
+    r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(src), "--out", str(out), "--filter",
+                        "none", "--take-end", "59", "--range-unit", "frames"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    back = bvh.read(out, min_range=None)
+    meta = back.metadata
+    assert meta["bvh_unit"].startswith("metres") and meta["bvh_up_axis"] == "+Z"
+    assert meta["bvh_position_channels"].startswith("position channels hold each joint's full local translation")
+    source = bvh.read(src, min_range=None).slice(slice(0, 60))
+    joints, samples = baked_figure.bake(back)
+    assert baked_figure.heights(joints, back.skeleton)["upright"]
+    assert baked_figure.limb_direction_errors(joints, samples, source).max() < 0.5

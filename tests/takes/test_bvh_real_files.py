@@ -1,4 +1,4 @@
-"""Real BVH files from seven exporters (tests/data/bvh/README.md): each maps by structure onto the Kinect
+"""Real BVH files from eight exporters (tests/data/bvh/README.md): each maps by structure onto the Kinect
 joints, with the right unit and up axis, and bakes an upright, human-sized figure that follows its joints."""
 from __future__ import annotations
 
@@ -30,6 +30,8 @@ EXPECTED = {
     "pymo_walk_meredith.bvh": ("inches", "+Y", {"HandLeft": "LeftHand_End", "Spine": "Hips + Spine",
                                                 "FootRight": "RightToeBase"}),
     "univrm_sample.bvh": ("centimetres", "+Y", {"ElbowRight": "RightForeArm", "HandLeft": "LeftHand_end"}),
+    "blender_export_kinect_rig.bvh": ("metres", "+Z", {"ShoulderLeft": "ElbowLeft", "WristRight": "HandRight",
+                                                       "HipLeft": "KneeLeft", "HandLeft": "HandLeft_end"}),
     "kinect_openni_nite.bvh": ("centimetres", "+Y", {**{j: j for j in KINECT_V1.joints if j[:-4] in (
         "Shoulder", "Elbow", "Wrist", "Knee", "Ankle") or j.startswith("Hip") and j != "HipCenter"},
         "Head": "Head", "ShoulderCenter": "ShoulderCenter", "HandLeft": "WristLeft_end"}),
@@ -62,6 +64,14 @@ def test_real_file_bakes_upright_human_sized_and_follows_its_joints(name):
     assert fig["upright"]
     assert 1.3 <= fig["head_to_foot_m"] <= 1.8
     assert baked_figure.limb_direction_errors(joints, samples, take).max() < 0.5
+
+
+def test_position_channels_read_per_file():
+    """Blender's exporter writes every joint's full local translation in its position channels; MakeHuman adds
+    small deltas to the OFFSET; the others have them on the root only."""
+    modes = {name: bvh.read_bvh_skeleton(DATA / name).position_mode for name in EXPECTED}
+    assert modes.pop("blender_export_kinect_rig.bvh") == "absolute" and set(modes.values()) == {"none"}
+    assert bvh.read_bvh_skeleton(DATA.parent / "meshes" / "makehuman" / "tpose.bvh").position_mode == "delta"
 
 
 def test_left_is_left_toes_point_forward():
