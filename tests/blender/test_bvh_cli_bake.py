@@ -78,3 +78,17 @@ def test_blender_bvh_export_reads_back_as_the_same_figure(tmp_path):
     joints, samples = baked_figure.bake(back)
     assert baked_figure.heights(joints, back.skeleton)["upright"]
     assert baked_figure.limb_direction_errors(joints, samples, source).max() < 0.5
+
+
+def test_bake_take_operator_scale_and_report(registered, capfd):
+    from kinect_retarget.blender.bake_take import new_generated_rig
+    bpy = registered
+    obj = new_generated_rig(bpy.context.scene, load_take(BVH))
+    bpy.context.view_layer.objects.active = obj
+    capfd.readouterr()
+    assert bpy.ops.kinect_retarget.bake_take(filepath=str(BVH), preset="kinect") == {"FINISHED"}
+    out = capfd.readouterr()
+    assert "BVH read in millimetres" in out.out + out.err and "m tall with the unit" not in out.out + out.err
+    assert bpy.ops.kinect_retarget.bake_take(filepath=str(BVH), preset="kinect", scale=0.01) == {"FINISHED"}
+    out = capfd.readouterr()
+    assert "the figure is 15.45 m tall with the unit 0.01 m per unit (given)" in out.out + out.err

@@ -94,3 +94,16 @@ def test_missing_hands_and_feet_are_extrapolated_along_the_limb():
     assert np.all(foot[:, 1] < 0)  # below the ankle
     shin = np.linalg.norm(p[:, k("AnkleRight")] - p[:, k("KneeRight")], axis=-1)
     assert np.allclose(np.linalg.norm(foot, axis=-1), 0.25 * shin * np.hypot(1, 0.4))
+
+
+def test_info_prints_the_mapping_joint_by_joint(capsys):
+    from kinect_retarget.cli import main
+    assert main(["info", str(DATA / "video2bvh_dance.bvh")]) == 0
+    out = capsys.readouterr().out
+    fields = dict(ln.split(None, 1) for ln in out.splitlines() if len(ln.split(None, 1)) == 2)
+    assert fields["unit"].startswith("millimetres (guessed from the standing height")
+    assert fields["up_axis"] == "+Z" and fields["position_channels"] == "position channels on the root only"
+    lines = out.splitlines()
+    start = lines.index("mapping")
+    assert [line.split()[0] for line in lines[start + 1:start + 21]] == list(KINECT_V1.joints)
+    assert ["HandLeft", "- (no hand node: extrapolated along the forearm)"] in [ln.split(None, 1) for ln in lines]

@@ -97,3 +97,22 @@ def test_layout_edge_cases(tmp_path, source_figure):
     (tmp_path / "empty.bvh").write_text(text)
     with pytest.raises(TakeError, match=r"empty\.bvh: BVH file has no frames \('Frames: 0'\): nothing to bake"):
         bvh.read(tmp_path / "empty.bvh")
+
+
+V2_NAMES = {"Hips": "SpineBase", "Spine1": "SpineMid", "Spine2": "SpineShoulder", "Neck": "Neck", "Head": "Head",
+            **{f"{side}{a}": f"{b}{side}" for side in ("Left", "Right") for a, b in (
+                ("Arm", "Shoulder"), ("ForeArm", "Elbow"), ("Hand", "Wrist"), ("HandMiddle1", "Hand"),
+                ("UpLeg", "Hip"), ("Leg", "Knee"), ("Foot", "Ankle"), ("ToeBase", "Foot"))}}
+
+
+def test_kinect_v2_named_bvh_maps_one_to_one(tmp_path, source_figure, reference):
+    fig = bv.Figure(**{**source_figure.__dict__, "names": [
+        V2_NAMES.get(n.split(":")[-1], n) for n in source_figure.names]})
+    bv.write(fig, tmp_path / "v2.bvh")
+    take = bvh.read(tmp_path / "v2.bvh", min_range=None)
+    mapping = take.metadata["bvh_mapping"]
+    v2 = {"HipCenter": "SpineBase", "Spine": "SpineMid", "ShoulderCenter": "SpineShoulder"}
+    for joint in KINECT_V1.joints:
+        assert mapping[joint] == f"{v2.get(joint, joint)} (Kinect name)"
+    limbs = [KINECT_V1.index(j) for j in KINECT_V1.joints if j not in v2 and j != "Head"]  # the named joints
+    np.testing.assert_allclose(take.positions[:, limbs], reference.positions[:, limbs], atol=2e-5)
