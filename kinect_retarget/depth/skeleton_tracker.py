@@ -22,7 +22,9 @@ from .segmentation import DepthGrid, FloorPlane, PersonMask, find_people, fit_fl
 from .skeleton_fit import FitResult, fit_person
 
 LOST_RESET_S = 0.5   # forget the previous pose after this long without the person (then re-acquire)
-CALIBRATION_FRAMES = 15
+CALIBRATION_FRAMES = 15    # with a floor: standing measurements blended into the height
+CALIBRATION_MEMORY = 300   # standing measurements kept for the height
+STANDING_PATCH = 0.53      # torso patch above the feet, fraction of the height, below which one is not standing
 
 
 @dataclass
@@ -45,6 +47,7 @@ class SkeletonTracker:
     def reset(self) -> None:
         self.floor: FloorPlane | None = None
         self.calibration = BodyCalibration()
+        self._heights: list[tuple[float, float]] = []
         self.confidence = ConfidenceCheck()
         self.status = "waiting for a person"
         self.frames = 0
@@ -133,19 +136,38 @@ class SkeletonTracker:
         return max(tall, key=lambda p: p.pixels / (1.0 + abs(p.centroid[0]) / max(p.centroid[2], 0.5)))
 
     def _calibrate(self, person: PersonMask, fit: FitResult, up: np.ndarray) -> None:
-        """Measure standing height on the first frames where the head and both feet are seen."""
-        if self.calibration.frames >= CALIBRATION_FRAMES or self.floor is None:
-            return
+        """Measure standing height where the head and both feet are seen, both feet down. With no floor in view
+        (pre-segmented frames, a sensor that does not see the floor) heights are taken above the person's
+        lowest point; every pose but standing upright is shorter (seated, crouched, bowing, sitting down), and
+        the lowest point is less sure than a floor, so the height is a high percentile of all measurements."""
+        if self.floor is not None and self.calibration.frames >= CALIBRATION_FRAMES:
+            return   # the floor's own height is sure: the first frames standing on it are enough
         labels = {k: p for k, p in fit.extrema}
         if not {"head", "FootLeft", "FootRight"} <= set(labels):
             return
-        feet_h = [self.floor.height(labels[k]) for k in ("FootLeft", "FootRight")]
         pts = self.last_grid.xyz[person.mask]
+        if self.floor is not None:
+            height = self.floor.height
+        else:
+            base = float(np.min(pts @ up))
+            height = lambda p: p @ up - base
+        feet_h = [height(labels[k]) for k in ("FootLeft", "FootRight")]
         near_head = pts[np.linalg.norm(pts - labels["head"], axis=1) < 0.2]
-        top = float(np.max(self.floor.height(near_head))) if len(near_head) else self.floor.height(labels["head"])
+        top = float(np.max(height(near_head))) if len(near_head) else float(height(labels["head"]))
+        patch = float(height(fit.torso_centre))
         if max(feet_h) > 0.15 or not 1.2 < top < 2.2:  # not standing on the floor
             return
-        self.calibration.update(top, float(self.floor.height(fit.torso_centre)))
+        if self.floor is not None:
+            self.calibration.update(top, patch)
+            return
+        if patch < STANDING_PATCH * top:
+            return  # seated: the torso sits low between the head and the feet
+        self._heights = (self._heights + [(top, patch)])[-CALIBRATION_MEMORY:]
+        tops = np.array([h for h, _ in self._heights])
+        c = self.calibration
+        c.height = float(np.percentile(tops, 90))
+        c.torso_patch_height = float(np.median([p / h for h, p in self._heights if h >= 0.97 * c.height]))
+        c.frames = len(self._heights)
 
 
 def track_depth_frames(depth_mm: np.ndarray, times: np.ndarray, camera: DepthCamera | None = None,

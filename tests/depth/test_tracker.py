@@ -95,3 +95,24 @@ def test_gravity_of_any_scale_gives_the_same_skeleton(rendered):
         assert unit.floor is None
         np.testing.assert_allclose(a[0], b[0], atol=1e-9)
         np.testing.assert_array_equal(a[1], b[1])
+
+
+def test_pre_segmented_frames_without_floor_or_gravity(rendered):
+    """Frames with only the person's pixels (floor and background removed, as some recorded datasets
+    store them) and no accelerometer: the tracker takes gravity as level, finds no floor, and still measures
+    the performer's height above their own lowest point."""
+    seq, _ = rendered
+    from kinect_retarget.core.conventions import depth_pixel_to_kinect
+    cam = SkeletonTracker().camera
+    v, u = np.mgrid[0:480, 0:640]
+    mm = seq.mm.copy()
+    for f in mm:
+        xyz = depth_pixel_to_kinect(u, v, f * 0.001, cam.f, cam.cx, cam.cy)
+        level_height = xyz @ -seq.gravity                # metres above the sensor, along gravity
+        f[(level_height < -0.88) | (xyz[..., 2] > 4.4)] = 0   # floor (sensor 0.9 m above it) and back wall
+    tracker = SkeletonTracker()
+    pos = np.stack([tracker.update(f, t)[0] for f, t in zip(mm, seq.times)])
+    assert tracker.floor is None and tracker.calibration.frames > 0
+    assert 1.5 < tracker.calibration.height < 1.8, tracker.calibration.height
+    err = np.linalg.norm(pos - seq.joints, axis=-1)
+    assert err.mean() < 0.08, err.mean()
