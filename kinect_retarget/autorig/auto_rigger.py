@@ -12,7 +12,8 @@ from .features import LABELS, FeaturePoints, find_feature_points
 from .graph import connected_components, mesh_graph
 from .joints import kinect_joints
 from .levels import SkeletonPoints, paper_skeleton
-from .mesh import Mesh, MeshError
+from .mirror import asymmetry, fit_mirror_plane, symmetrize_joints
+from .mesh import Mesh, MeshError, nearest_vertex
 from .weights import bone_projection_weights
 
 LEVELS = 4  # the paper's K
@@ -60,17 +61,6 @@ def _check_single_body(mesh: Mesh, comp: np.ndarray) -> None:
                         f"({sizes[0]} and {sizes[1]} vertices): several bodies? Rig one character at a time")
 
 
-def _nearest(points: np.ndarray, targets: np.ndarray, chunk: int = 1024) -> np.ndarray:
-    """Index of the nearest target for each point (brute force in float32 chunks: no scipy in Blender)."""
-    out = np.empty(len(points), dtype=np.int64)
-    t = targets.astype(np.float32)
-    t2 = (t ** 2).sum(axis=1)
-    for s in range(0, len(points), chunk):
-        p = points[s:s + chunk].astype(np.float32)
-        out[s:s + chunk] = np.argmin(t2[None, :] - 2 * p @ t.T, axis=1)
-    return out
-
-
 def autorig(mesh: Mesh, levels: int = LEVELS) -> AutoRig:
     """Rig a humanoid mesh. Raises MeshError with what was found when no human skeleton can be built."""
     t0 = time.perf_counter()
@@ -98,6 +88,13 @@ def autorig(mesh: Mesh, levels: int = LEVELS) -> AutoRig:
     joints = kinect_joints(v, body_mesh.faces, fp, segment, height)
     if not np.all(np.isfinite(joints)):
         raise MeshError(f"{mesh.name}: joint placement failed (non-finite positions)")
+    # A body that is its own mirror image gets a mirror-symmetric rig (mirror.py: geodesics measured on a
+    # triangulation that is not itself mirrored place the two sides' joints differently).
+    plane = fit_mirror_plane(v, body_mesh.faces, fp.left, height)
+    mirror = {"symmetric": plane.symmetric, "surface_mismatch_pct": round(plane.mismatch * 100, 4),
+              "joint_asymmetry_found_pct": round(asymmetry(joints, plane, height), 4)}
+    if plane.symmetric:
+        joints = symmetrize_joints(joints, plane)
     timings["joints"] = time.perf_counter() - t0
     # Every vertex gets weights: other pieces (eyes, teeth, clothes) take the segment of the nearest body
     # vertex, so they follow the body part they sit on.
@@ -111,13 +108,13 @@ def autorig(mesh: Mesh, levels: int = LEVELS) -> AutoRig:
     report = {"body_vertices": int(len(body)), "components": int(comp.max()) + 1,
               "bound_vertices": int(len(others)), "feature_points": {l: v[i].tolist() for l, i in zip(LABELS, fp.vertices)},
               "up": fp.up.tolist(), "front": fp.front.tolist(), "seconds": time.perf_counter() - t0,
-              "timings": timings, "levels": levels, "points_per_level": paper.count_per_level(levels).tolist()}
+              "timings": timings, "levels": levels, "mirror": mirror, "points_per_level": paper.count_per_level(levels).tolist()}
     return AutoRig(KINECT_V1, joints, index, weight, body, segment, fp, paper, height, report, v)
 
 
 def _segment_of_nearest(points: np.ndarray, body: np.ndarray, segment: np.ndarray) -> np.ndarray:
     sample = np.arange(0, len(body), 4)  # a quarter of the body is plenty to tell which part a piece sits on
-    return segment[sample[_nearest(points, body[sample])]]
+    return segment[sample[nearest_vertex(points, body[sample])]]
 
 
 def bind_mesh(rig: AutoRig, mesh: Mesh) -> tuple[np.ndarray, np.ndarray]:

@@ -62,6 +62,17 @@ def subdivide(mesh: Mesh, face_mask: np.ndarray | None = None) -> Mesh:
     return Mesh(verts, np.concatenate([mesh.faces[~chosen]] + new), mesh.name + "-subdivided")
 
 
+def nearest_vertex(points: np.ndarray, targets: np.ndarray, chunk: int = 1024) -> np.ndarray:
+    """Index of the nearest target for each point (brute force in float32 chunks: no scipy in Blender)."""
+    out = np.empty(len(points), dtype=np.int64)
+    t = targets.astype(np.float32)
+    t2 = (t ** 2).sum(axis=1)
+    for s in range(0, len(points), chunk):
+        p = points[s:s + chunk].astype(np.float32)
+        out[s:s + chunk] = np.argmin(t2[None, :] - 2 * p @ t.T, axis=1)
+    return out
+
+
 def triangulate(polygons: list[list[int]]) -> np.ndarray:
     """Fan-triangulate polygons given as vertex-index lists (vectorised per polygon size)."""
     out = []

@@ -25,7 +25,7 @@ def test_rest_pose_joints_within_3_percent(mh, rest_rig):
 
 def test_symmetric_and_inside(mh, rest_rig):
     # MakeHuman is symmetric about x = 0 and faces +Z: its left is +X.
-    assert symmetry_error(rest_rig.joints, np.array([1.0, 0, 0]), np.zeros(3), mh.height) < 1.0
+    assert symmetry_error(rest_rig.joints, np.array([1.0, 0, 0]), np.zeros(3), mh.height) < 0.5
     assert inside_mesh(rest_rig.joints, mh.body.vertices, mh.body.faces).all()
     assert rest_rig.joints[KINECT_V1.index("HandLeft"), 0] > 0 > rest_rig.joints[KINECT_V1.index("HandRight"), 0]
 
