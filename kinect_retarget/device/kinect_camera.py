@@ -60,6 +60,8 @@ def access_advice(exc: BaseException, role: str = "camera", platform: str | None
     """Why the OS refused to open the device, and the fix for this platform. `role`: camera, motor, audio."""
     platform = platform or sys.platform
     code = getattr(exc, "errno", None)
+    if is_io_error(exc):
+        return IO_ERROR_ADVICE
     if code == errno.EBUSY:
         return ("the device is busy: another program (libfreenect, a previous Blender session) holds it; "
                 "close it and try again")

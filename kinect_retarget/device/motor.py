@@ -16,7 +16,7 @@ import usb.core
 import usb.util
 
 from . import protocol as P
-from .kinect_camera import access_advice, is_gone
+from .kinect_camera import IO_ERROR_ADVICE, access_advice, is_gone, is_io_error
 from .discovery import KinectInfo, find_kinect
 from .audio_firmware import boot_audio_chip, find_firmware
 from .errors import AccessDenied, BadInputFile, DeviceGone, KinectError, MotorUnavailable, ProtocolError
@@ -51,6 +51,8 @@ def _usb_io(fn, *args, role: str = "motor"):
     except usb.core.USBError as exc:
         if is_gone(exc):
             raise DeviceGone("the Kinect was unplugged") from exc
+        if is_io_error(exc):
+            raise KinectError(f"the Kinect {role} failed with {IO_ERROR_ADVICE}") from exc
         raise AccessDenied(f"cannot use the Kinect {role}: {access_advice(exc, role)}") from exc
     except NotImplementedError as exc:
         raise AccessDenied(f"cannot use the Kinect {role}: {access_advice(exc, role)}") from exc

@@ -53,6 +53,9 @@ def test_linux_names_the_udev_rule_only_for_permission_errors():
     assert "udev" in access_advice(denied, platform="linux")
     assert "udev" not in access_advice(busy, platform="linux") and "another program" in access_advice(busy)
     assert "udev" not in access_advice(other, platform="linux")
+    for system in ("linux", "win32", "darwin"):                          # EIO: not a setup problem anywhere
+        text = access_advice(other, platform=system)
+        assert "I/O error" in text and "12 V" in text and "Zadig" not in text
 
 
 def test_windows_names_the_device_to_pick_in_zadig():
