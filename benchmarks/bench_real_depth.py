@@ -26,8 +26,8 @@ import numpy as np
 from _common import SHARED_DATA
 
 from kinect_retarget.core.skeletons import KINECT_V1, NOT_TRACKED, TRACKED
-from kinect_retarget.depth.camera import DepthCamera
-from kinect_retarget.depth.tracker import SkeletonTracker, TrackerSettings
+from kinect_retarget.depth.depth_camera import DepthCamera
+from kinect_retarget.depth.skeleton_tracker import SkeletonTracker, TrackerSettings
 
 DATA = SHARED_DATA / "utd_mhad_dev"
 FOCAL_640 = 571.26
