@@ -32,7 +32,7 @@ def pump_like_the_timer(seconds: float, interval: float, on_tick=None) -> None:
     depsgraph update a viewport redraw would do after a pose change."""
     import bpy
 
-    from kinect_retarget.blender.live import live_controller as live
+    from kinect_retarget.blender.live import live_runtime as live
 
     view_layer = bpy.context.view_layer
     start = time.perf_counter()

@@ -23,7 +23,7 @@ def measure(obj, take, preset: str, frames: int) -> dict:
     evaluation the viewport's redraw performs after a pose change."""
     import bpy
 
-    from kinect_retarget.blender.live import live_controller as live
+    from kinect_retarget.blender.live import live_runtime as live
     from kinect_retarget.sources.frame_source import FrameSource
 
     class Idle(FrameSource):

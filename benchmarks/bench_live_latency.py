@@ -21,7 +21,7 @@ def main() -> None:
     import bpy
 
     import kinect_retarget
-    from kinect_retarget.blender.live import live_controller as live
+    from kinect_retarget.blender.live import live_runtime as live
 
     live_scene(speed=1.0)
     c = live.start_live(bpy.context, use_timer=False)

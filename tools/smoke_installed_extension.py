@@ -36,7 +36,7 @@ def _sidebar_child(zip_path: str, seconds: float) -> dict:
     assets = importlib.import_module(EXT + ".assets")
     out["assets_in_installed_copy"] = Path(assets.ASSETS_DIR).resolve().is_relative_to(root.resolve())
     usb_panel = importlib.import_module(EXT + ".blender.live.usb_service")
-    live = importlib.import_module(EXT + ".blender.live.live_controller")
+    live = importlib.import_module(EXT + ".blender.live.live_runtime")
     kinect_rig = importlib.import_module(EXT + ".blender.io.kinect_rig")
     layout = importlib.import_module(EXT + ".core.kinect_rig_layout")
     skeletons = importlib.import_module(EXT + ".core.skeletons")

@@ -6,13 +6,13 @@ from __future__ import annotations
 import bpy
 
 from . import clip_lift, mesh_autorig
-from .live import live_controller, usb_service
-from .ui import bake_operator, mapping_table, menus, panels, preferences, properties
+from .live import live_runtime, usb_service
+from .ui import bake_operator, live_operators, mapping_table, menus, panels, preferences, properties
 
-CLASSES = (*bake_operator.CLASSES, *preferences.CLASSES, *properties.CLASSES, *live_controller.CLASSES,
+CLASSES = (*bake_operator.CLASSES, *preferences.CLASSES, *properties.CLASSES, *live_operators.CLASSES,
            *mapping_table.CLASSES, *panels.CLASSES, *usb_service.CLASSES, *mesh_autorig.CLASSES,
            *clip_lift.CLASSES, *menus.CLASSES)
-HOOKS = (properties, live_controller, usb_service, mesh_autorig, clip_lift, menus)   # register_extra/unregister_extra
+HOOKS = (properties, live_runtime, usb_service, mesh_autorig, clip_lift, menus)   # register_extra/unregister_extra
 
 _done = {"classes": 0, "hooks": 0}   # how far register() got, so unregister() undoes exactly that
 

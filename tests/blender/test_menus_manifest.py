@@ -83,10 +83,11 @@ def test_osc_other_machines_only_with_online_access(bpy_empty, listen_all, onlin
     assert osc_host(None, online=True) == ("127.0.0.1", None)
 
 
-def test_osc_source_binds_loopback_while_online_access_is_off(bpy_empty):
+def test_osc_source_binds_loopback_while_online_access_is_off(bpy_empty, monkeypatch):
     bpy = bpy_empty
-    from kinect_retarget.blender.live.live_controller import make_source
+    from kinect_retarget.blender.live import live_runtime
     assert bpy.app.online_access is False  # headless bpy: no online access
-    source, label = make_source(SimpleNamespace(source="OSC", osc_port=7123),
-                                SimpleNamespace(osc_listen_all=True))
+    monkeypatch.setattr(live_runtime, "get_preferences", lambda context: SimpleNamespace(osc_listen_all=True))
+    context = SimpleNamespace(scene=SimpleNamespace(kinect_retarget=SimpleNamespace(source="OSC", osc_port=7123)))
+    source, label = live_runtime.source_from_scene(context)
     assert source.host == "127.0.0.1" and "this computer only" in label

@@ -15,7 +15,7 @@ import pytest
 
 import kinect_retarget
 from kinect_retarget.core.kinect_rig_layout import typical_segment_lengths
-from kinect_retarget.blender.live import live_controller as live, usb_service as usb_panel
+from kinect_retarget.blender.live import live_runtime as live, usb_service as usb_panel
 from kinect_retarget.blender.io.kinect_rig import build_kinect_rig
 from kinect_retarget.core.skeletons import KINECT_V1
 from kinect_retarget.device import LibusbMissing, list_devices, open_motor
@@ -325,8 +325,7 @@ def test_panel_shows_devices_status_tilt_and_preview(registered, monkeypatch, fa
     assert not usb_panel.KINECT_RETARGET_PT_usb.poll(bpy.context)
 
 
-def test_unregister_leaves_no_timer_stream_thread_or_hook(registered):
-    assert live.usb_source_factory is usb_panel._make_usb_source
+def test_unregister_leaves_no_timer_stream_or_thread(registered):
     _simulate(registered)
     bpy.ops.kinect_retarget.usb_preview()
     _pump_until(lambda: usb_panel.stream_status().frames >= 1)
@@ -337,7 +336,6 @@ def test_unregister_leaves_no_timer_stream_thread_or_hook(registered):
     try:
         assert not bpy.app.timers.is_registered(usb_panel.update_preview)
         assert not stream.running and not _our_threads()
-        assert live.usb_source_factory is None
         assert usb_panel.IMAGE_NAME not in bpy.data.images and usb_panel._rt.previews is None
         assert not hasattr(bpy.types.Scene, "kinect_retarget_usb")
     finally:

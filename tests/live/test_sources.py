@@ -66,6 +66,7 @@ def test_playback_file_vanishing_stops_with_error(wave_take_file):
 def test_open_source_specs(wave_take_file):
     assert isinstance(open_source(f"take:{wave_take_file}"), TakePlayback)
     assert isinstance(open_source("osc:9001"), OscReceiver)
+    assert isinstance(open_source("usb"), UsbKinectSource) and not open_source("usb").alive   # opens on start
     with pytest.raises(SourceError, match="unknown source"):
         open_source("webcam")
     with pytest.raises(SourceError, match="must be a number"):
@@ -180,12 +181,14 @@ def test_osc_socket_error_on_the_thread_stops_with_error():
 
 
 # -- USB -----------------------------------------------------------------------------------------------
-def test_usb_without_tracker_refuses_with_a_sentence(monkeypatch):
-    from kinect_retarget.sources import usb_kinect as usb
-    monkeypatch.setattr(usb, "PRODUCER_MODULES", (".no_such_tracker",))
-    assert "no depth-to-skeleton tracker" in usb.usb_status()
-    src = UsbKinectSource(factory=None)
-    with pytest.raises(SourceError, match="tracker"):
+def test_usb_opens_the_depth_tracker_by_default_and_says_why_it_cannot(monkeypatch):
+    from kinect_retarget.sources import depth_skeletons
+
+    def no_device(**_kwargs):
+        raise OSError("no Kinect on the bus")
+    monkeypatch.setattr(depth_skeletons, "open_skeleton_producer", no_device)
+    src = UsbKinectSource()
+    with pytest.raises(SourceError, match="cannot open the device .no Kinect on the bus"):
         src.start(FrameQueue())
     assert not src.alive
 
@@ -235,11 +238,7 @@ def test_source_rejects_nan_for_tracked_joints(rng):
     assert "NaN" in src.error and "HandLeft" in src.error
 
 
-def test_usb_finds_the_depth_tracker_and_times_out_without_frames(monkeypatch):
-    from kinect_retarget.sources import usb_kinect as usb
-    factory, reason = usb.find_skeleton_producer()
-    assert factory is not None and factory.__module__.endswith("sources.depth_skeletons"), reason
-
+def test_usb_times_out_without_frames(monkeypatch):
     class Silent(FakeProducer):
         class stream:
             class status:

@@ -20,9 +20,8 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty
 from ...device import (DepthStream, KinectError, MotorUnavailable, depth_preview, list_devices,
                       open_motor)
 from ...device.motor import LED_MODES, TILT_LIMIT_DEG
-from ...sources import SourceError, UsbKinectSource
-from ...sources.usb_kinect import find_skeleton_producer
-from . import live_controller
+from ...sources import SourceError, UsbKinectSource, open_source
+from . import live_runtime
 
 PREVIEW_INTERVAL = 0.2          # seconds: 5 preview updates per second are plenty and cost the UI ~nothing
 PREVIEW_SCALE = 2               # 640x480 depth -> a 320x240 preview
@@ -178,13 +177,13 @@ def devices() -> list[dict] | None:
 # -- the panel's own depth stream -----------------------------------------------------------------------------
 def _live_producer():
     """The live session's skeleton producer when live runs on the USB Kinect, else None."""
-    c = live_controller.controller()
+    c = live_runtime.controller()
     src = c.session.source if c is not None else None
     return src.producer if isinstance(src, UsbKinectSource) else None
 
 
 def live_uses_usb() -> bool:
-    c = live_controller.controller()
+    c = live_runtime.controller()
     return c is not None and isinstance(c.session.source, UsbKinectSource)
 
 
@@ -275,7 +274,7 @@ def update_preview() -> float | None:
             _upload(rgba)
             changed = True
         if changed:
-            live_controller.redraw_3d_views()
+            live_runtime.redraw_3d_views()
     except Exception as exc:  # a timer that raises is dropped silently by Blender: say it, and go on
         print(f"kinect_retarget: depth preview: {type(exc).__name__}: {exc}")
     busy = discovering() or _preparing_simulated() or stream_running() or live_uses_usb()
@@ -289,21 +288,15 @@ def ensure_timer() -> None:
 
 
 # -- live on the USB Kinect ------------------------------------------------------------------------------------
-def _make_usb_source(settings, prefs):
-    """The USB source for live (live_controller.usb_source_factory): the simulated Kinect when chosen, and the device
-    freed from the panel's own preview stream first."""
+def live_usb_source(context) -> tuple[UsbKinectSource, str]:
+    """The USB source for live (live_runtime.source_from_scene) and its label: the simulated Kinect when chosen,
+    and the device freed from the panel's own preview stream first."""
     stop_stream()
-    usb = getattr(settings.id_data, "kinect_retarget_usb", None)
-    if usb is not None and usb.simulate:
-        backend = _simulated_or_error()
-        factory, reason = find_skeleton_producer()
-        if factory is None:
-            raise SourceError(f"USB Kinect: {reason}")
-        source, label = UsbKinectSource(factory=lambda: factory(source=backend)), "simulated USB Kinect"
-    else:
-        source, label = UsbKinectSource(), "USB Kinect"
+    usb = getattr(context.scene, "kinect_retarget_usb", None)
+    simulated = usb is not None and usb.simulate
+    source = open_source("usb", usb_backend=_simulated_or_error() if simulated else None)
     ensure_timer()
-    return source, label
+    return source, "simulated USB Kinect" if simulated else "USB Kinect"
 
 
 # -- properties -------------------------------------------------------------------------------------------------
@@ -533,11 +526,10 @@ class KINECT_RETARGET_PT_usb(bpy.types.Panel):
 def register_extra() -> None:
     bpy.types.Scene.kinect_retarget_usb = bpy.props.PointerProperty(type=KinectRetargetUsbSettings)
     _rt.previews = bpy.utils.previews.new()
-    live_controller.usb_source_factory = _make_usb_source
 
 
 def unregister_extra() -> None:
-    """Undo everything: the timer, the panel's stream, helper threads, the preview, the live hook."""
+    """Undo everything: the timer, the panel's stream, helper threads, the preview."""
     if bpy.app.timers.is_registered(update_preview):
         bpy.app.timers.unregister(update_preview)
     stop_stream()
@@ -546,7 +538,6 @@ def unregister_extra() -> None:
         if thread is not None:
             thread.join(THREAD_JOIN_S)   # short ones; a first render cannot be interrupted (it touches no bpy)
     _rt.discovery = _rt.sim_thread = _rt.discovery_result = None
-    live_controller.usb_source_factory = None
     if _rt.previews is not None:
         bpy.utils.previews.remove(_rt.previews)
         _rt.previews = None

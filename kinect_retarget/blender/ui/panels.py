@@ -4,7 +4,7 @@ from __future__ import annotations
 import bpy
 
 from ..io.armature_probe import fallback_bones
-from ..live import live_controller
+from ..live import live_runtime
 from ..live.osc_access import osc_host
 from .bake_settings import draw_bake_options
 from .preferences import get_preferences
@@ -17,19 +17,14 @@ class _KinectPanel:
     bl_category = "Kinect"
 
 
-def _usb_status() -> str:
-    from ...sources.usb_kinect import usb_status
-    return usb_status()
-
-
 class KINECT_RETARGET_PT_main(_KinectPanel, bpy.types.Panel):
     bl_label = "Kinect Retarget"
 
     def draw(self, context):
         layout = self.layout
         s = context.scene.kinect_retarget
-        st = live_controller.status()
-        running = live_controller.controller() is not None
+        st = live_runtime.status()
+        running = live_runtime.controller() is not None
 
         box = layout.box()
         col = box.column()
@@ -46,7 +41,7 @@ class KINECT_RETARGET_PT_main(_KinectPanel, bpy.types.Panel):
             if refused:
                 col.label(text=refused, icon="INTERNET_OFFLINE")
         else:
-            col.label(text=_usb_status(), icon="INFO")
+            col.label(text="Skeletons from the depth tracker (devices: USB Kinect below)", icon="INFO")
         self._draw_status(box, st)
 
         col = layout.column(align=True)
@@ -98,7 +93,7 @@ class KINECT_RETARGET_PT_target(_KinectPanel, bpy.types.Panel):
     def draw(self, context):
         layout = self.layout
         s = context.scene.kinect_retarget
-        layout.enabled = live_controller.controller() is None
+        layout.enabled = live_runtime.controller() is None
         layout.prop(s, "armature")
         obj = target_armature(context)
         if obj is None:
@@ -118,7 +113,7 @@ class KINECT_RETARGET_PT_mapping(_KinectPanel, bpy.types.Panel):
     def draw(self, context):
         layout = self.layout
         s = context.scene.kinect_retarget
-        layout.enabled = live_controller.controller() is None
+        layout.enabled = live_runtime.controller() is None
         row = layout.row()
         row.template_list("KINECT_RETARGET_UL_mapping", "", s, "mapping", s, "mapping_index", rows=6)
         col = row.column(align=True)
@@ -144,7 +139,7 @@ class KINECT_RETARGET_PT_options(_KinectPanel, bpy.types.Panel):
         layout.use_property_split = True
         s = context.scene.kinect_retarget
         col = layout.column()
-        col.enabled = live_controller.controller() is None
+        col.enabled = live_runtime.controller() is None
         col.prop(s, "filter")
         col.prop(s, "root")
         col.prop(s, "mirror")

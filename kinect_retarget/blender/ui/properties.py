@@ -1,6 +1,6 @@
 """Per-scene Kinect settings (scene.kinect_retarget): source, target, mapping table, filter, record options.
 
-Live status is runtime state (blender/live/live_controller.py), not stored here, so live never dirties the file or undo.
+Live status is runtime state (blender/live/live_runtime.py), not stored here, so live never dirties the file or undo.
 """
 from __future__ import annotations
 
