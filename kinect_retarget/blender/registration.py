@@ -7,12 +7,13 @@ import bpy
 
 from . import clip_lift, mesh_autorig
 from .live import live_runtime, usb_service
-from .ui import bake_operator, live_operators, mapping_table, menus, panels, preferences, properties
+from .ui import bake_operator, live_operators, mapping_table, menus, panels, preferences, properties, usb_panel
 
 CLASSES = (*bake_operator.CLASSES, *preferences.CLASSES, *properties.CLASSES, *live_operators.CLASSES,
-           *mapping_table.CLASSES, *panels.CLASSES, *usb_service.CLASSES, *mesh_autorig.CLASSES,
+           *mapping_table.CLASSES, *panels.CLASSES, *usb_panel.CLASSES, *mesh_autorig.CLASSES,
            *clip_lift.CLASSES, *menus.CLASSES)
-HOOKS = (properties, live_runtime, usb_service, mesh_autorig, clip_lift, menus)   # register_extra/unregister_extra
+# modules with register_extra()/unregister_extra(), in order
+HOOKS = (properties, live_runtime, usb_service, usb_panel, mesh_autorig, clip_lift, menus)
 
 _done = {"classes": 0, "hooks": 0}   # how far register() got, so unregister() undoes exactly that
 

@@ -10,7 +10,6 @@ from __future__ import annotations
 import queue
 import threading
 
-import numpy as np
 
 from ..core.skeletons import KINECT_V1
 from ..device.protocol import TIMESTAMP_HZ, TIMESTAMP_WRAP

@@ -16,6 +16,7 @@ import pytest
 import kinect_retarget
 from kinect_retarget.core.kinect_rig_layout import typical_segment_lengths
 from kinect_retarget.blender.live import live_runtime as live, usb_service as usb_panel
+from kinect_retarget.blender.ui import usb_panel as usb_ui
 from kinect_retarget.blender.io.kinect_rig import build_kinect_rig
 from kinect_retarget.core.skeletons import KINECT_V1
 from kinect_retarget.device import LibusbMissing, list_devices, open_motor
@@ -122,7 +123,7 @@ def test_tilt_says_plainly_when_the_motor_needs_firmware(registered, monkeypatch
     reports = []
     op = SimpleNamespace(angle=0.1, properties=SimpleNamespace(is_property_set=lambda name: True),
                          report=lambda level, msg: reports.append((level, msg)))
-    assert usb_panel.KINECT_RETARGET_OT_usb_tilt.execute(op, bpy.context) == {"CANCELLED"}
+    assert usb_ui.KINECT_RETARGET_OT_usb_tilt.execute(op, bpy.context) == {"CANCELLED"}
     (level, msg), = reports
     assert level == {"ERROR"} and "motor is not available" in msg and "firmware" in msg
 
@@ -289,7 +290,7 @@ class _FakeLayout:
 def _draw(context) -> list:
     log = []
     panel = SimpleNamespace(layout=_FakeLayout(log))
-    cls = usb_panel.KINECT_RETARGET_PT_usb
+    cls = usb_ui.KINECT_RETARGET_PT_usb
     for name in ("_draw_devices", "_draw_stream", "_draw_motor", "_draw_preview"):
         setattr(panel, name, getattr(cls, name))
     cls.draw(panel, context)
@@ -297,7 +298,7 @@ def _draw(context) -> list:
 
 
 def test_panel_shows_devices_status_tilt_and_preview(registered, monkeypatch, fakenect_frames):
-    assert usb_panel.KINECT_RETARGET_PT_usb.poll(bpy.context)
+    assert usb_ui.KINECT_RETARGET_PT_usb.poll(bpy.context)
     text = " | ".join(t for kind, t in _draw(bpy.context) if kind == "label")
     assert "Press Refresh" in text and "Not streaming" in text
     _simulate(registered)
@@ -322,7 +323,7 @@ def test_panel_shows_devices_status_tilt_and_preview(registered, monkeypatch, fa
     text = " ".join(t for kind, t in _draw(bpy.context) if kind == "label")
     assert "Motor: not available" in text and "firmware" in text
     registered.kinect_retarget.source = "TAKE"
-    assert not usb_panel.KINECT_RETARGET_PT_usb.poll(bpy.context)
+    assert not usb_ui.KINECT_RETARGET_PT_usb.poll(bpy.context)
 
 
 def test_unregister_leaves_no_timer_stream_or_thread(registered):
