@@ -12,7 +12,7 @@ import usb.core
 
 from . import protocol as P
 from .depth_stream import ERROR, DepthStream
-from .discovery import list_devices
+from .discovery import list_devices, nothing_found_reason
 from .errors import KinectError
 from .kinect_camera import KinectCamera
 from .motor import send_keep_alive
@@ -110,7 +110,7 @@ def diagnose(backend=None, stream_seconds: float = STREAM_TRY_S) -> str:
     lines += _bus_lines(backend)
     kinects = list_devices(backend)
     if not kinects:
-        lines.append("no Kinect v1 camera (045e:02ae or 045e:02bf) found: check its 12 V adapter and cable")
+        lines.append(f"no Kinect v1 camera (045e:02ae or 045e:02bf) found: {nothing_found_reason(backend)}")
     for info in kinects:
         lines.append(f"{info.model}  serial {info.serial}  camera bus {info.bus} address {info.address}")
         for role in ("motor", "audio"):

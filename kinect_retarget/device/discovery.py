@@ -158,6 +158,27 @@ def list_devices(backend=None) -> list[KinectInfo]:
     return found
 
 
+KINECT_V2_PIDS = (0x02D8, 0x02D9, 0x02C4)
+
+
+def nothing_found_reason(backend) -> str:
+    """Why no Kinect camera was found, from what else of Microsoft's is on the bus."""
+    try:
+        others = {d.idProduct for d in usb.core.find(find_all=True, idVendor=P.VENDOR_MICROSOFT,
+                                                     backend=backend or find_backend())}
+    except (usb.core.USBError, NotImplementedError):
+        others = set()
+    if others & set(KINECT_V2_PIDS):
+        return ("no Kinect v1 found, but a Kinect v2 (Xbox One / Kinect for Windows v2) is plugged in: it is a "
+                "different device (USB 3, another protocol) that this driver does not support (libfreenect2 does)")
+    if others & set(P.MOTOR_PIDS + P.AUDIO_PIDS):
+        return ("the Kinect's motor or audio device is on the bus but not its camera: check that its own 12 V "
+                "power adapter is plugged in; on Windows the camera may also appear only once the motor "
+                "device has a driver (Zadig: 'Xbox NUI Motor', USB ID 045E 02B0)")
+    return ("no Kinect found: check that it is plugged in and powered by its own adapter "
+            "(a v1 Kinect needs the external 12 V supply)")
+
+
 def find_kinect(backend=None, serial: str | None = None) -> KinectInfo:
     """The Kinect with this serial (or the first one); DeviceNotFound says what was seen instead."""
     kinects = list_devices(backend)
@@ -165,8 +186,7 @@ def find_kinect(backend=None, serial: str | None = None) -> KinectInfo:
         if serial is None or info.serial == serial:
             return info
     if not kinects:
-        raise DeviceNotFound("no Kinect found: check that it is plugged in and powered by its own adapter "
-                             "(a v1 Kinect needs the external 12 V supply)")
+        raise DeviceNotFound(nothing_found_reason(backend))
     raise DeviceNotFound(f"no Kinect with serial {serial}; found {', '.join(k.serial for k in kinects)}")
 
 

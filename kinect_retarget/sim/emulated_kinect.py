@@ -183,7 +183,9 @@ class EmulatedKinect(usb.backend.IBackend):
     def enumerate_devices(self):
         with self._lock:
             self._update_plug()
-            return list(self.functions) if self._generation >= 0 else []
+            if self._generation < 0:
+                return []
+            return [fn for fn in self.functions if not (self.faults.no_power and fn.kind == "camera")]
 
     def get_device_descriptor(self, dev):
         return dev.device_descriptor(self.bus)

@@ -29,6 +29,7 @@ class Faults:
     replug_at: float | None = None
     access_denied: bool = False                # open() fails as without a udev rule
     denied: tuple[str, ...] = ()               # only these devices ("camera", "motor", "audio") refuse to open
+    no_power: bool = False                     # no 12 V adapter: motor and audio enumerate, the camera does not
     seed: int = 0
     # --- what real hosts and devices do (libfreenect issues in docs/usb_driver.md) ---
     unplug_cancels: bool = False               # on unplug transfers come back CANCELLED (libusb on macOS)

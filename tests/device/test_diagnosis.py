@@ -30,6 +30,8 @@ def test_report_says_what_failed(real_depth):
     assert "LIBUSB_ERROR_IO" in text and "bandwidth" in text
     denied = diagnose(EmulatedKinect(real_depth[:1], faults=Faults(access_denied=True)))
     assert "camera: not usable:" in denied and "depth stream" not in denied
+    unpowered = diagnose(EmulatedKinect(real_depth[:1], faults=Faults(no_power=True)))
+    assert "045e:02b0" in unpowered and "no Kinect v1 camera" in unpowered and "12 V" in unpowered
 
 
 def test_devices_diagnose_command(capsys):

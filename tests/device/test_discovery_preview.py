@@ -38,7 +38,7 @@ def test_find_kinect_by_serial(real_depth):
 
 
 def test_udev_rule_covers_every_kinect_device():
-    for pid in ("02ae", "02bf", "02b0", "02c2", "02ad", "02be"):
+    for pid in ("02ae", "02bf", "02b0", "02c2", "02ad", "02be", "02c3", "02bb"):
         assert f'ATTR{{idProduct}}=="{pid}"' in UDEV_RULES
 
 

@@ -77,3 +77,15 @@ def test_an_audio_device_that_cannot_be_opened_is_not_called_missing_firmware(re
     assert "cannot be read" in info.motor_note and "firmware" not in info.motor_note
     info = list_devices(EmulatedKinect(real_depth[:1], model="1473"))[0]
     assert "audios.bin" in info.motor_note and "fwfetcher" in info.motor_note
+
+
+def test_a_kinect_without_its_12_v_adapter_is_named_as_such(real_depth):
+    from kinect_retarget.device.discovery import find_kinect
+    from kinect_retarget.device.errors import DeviceNotFound
+    for model in ("1414", "1473"):
+        with pytest.raises(DeviceNotFound, match="motor or audio device is on the bus but not its camera.*12 V"):
+            find_kinect(EmulatedKinect(real_depth[:1], model=model, faults=Faults(no_power=True)))
+    emu = EmulatedKinect(real_depth[:1])
+    emu.unplug()
+    with pytest.raises(DeviceNotFound, match="no Kinect found"):
+        find_kinect(emu)
