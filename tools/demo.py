@@ -2,11 +2,11 @@
 .blend per take and rig, render a few Workbench stills of each with a simple body mesh, print a summary.
 
     .venv/bin/python tools/demo.py --out demo_output [--takes A.krtake ...] [--all] [--no-rigify]
-        [--no-render] [--stills 3] [--rigify-frames 90] [--resolution 640x480] [--docs-images docs/images]
+        [--no-render] [--stills 3] [--rigify-frames N] [--resolution 640x480] [--docs-images docs/images]
 
 Everything runs headless in one process (bpy as a module). The Rigify rig is generated once from Blender's
-human metarig (rigify_generate) and reopened for each Rigify take; baking onto it is slow (Blender evaluates
-its constraint-driven parents frame by frame), so Rigify takes are cut to their first --rigify-frames frames.
+human metarig (rigify_generate) and reopened for each Rigify take, which is baked whole (its constraint-driven
+parents are learned once and solved in numpy, issue 15); --rigify-frames N cuts Rigify takes to N frames.
 """
 from __future__ import annotations
 
@@ -40,7 +40,7 @@ DOCS_IMAGES = {("kinect_v2_ges01_wavehand", "kinect"): "demo_wavehand_kinect_rig
                ("kinect_v1_cmu_131_03_hop", "kinect"): "demo_cmu_hop_kinect_rig.png",
                ("kinect_v2_ges01_wavehand", "rigify"): "demo_wavehand_rigify.png"}
 DOCS_IMAGE_LIMIT = 100_000  # bytes: keep the repository light
-RIGIFY_FRAMES = 90  # 3 s of each take: Rigify bakes evaluate the rig frame by frame (slow)
+RIGIFY_FRAMES = 0  # whole takes: a Rigify bake costs about what the generated rig's does (issue 15)
 RIGS = {"kinect": "generated Kinect rig", "rigify": "Rigify rig (human metarig)"}
 
 

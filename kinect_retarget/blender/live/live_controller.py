@@ -128,8 +128,9 @@ class LiveController:
             if self.exact:  # fallback bones evaluated on the armature copy until they settle
                 if self.evaluator is None:
                     self.evaluator = ArmatureEvaluator(obj, model.rig.bone_names, self._switches)
+                scene = self.scene()  # drivers on animated properties: evaluate at the frame shown
                 pose.quats = solve_frames(self.evaluator, model, pose.desired[None], pose.root_bone,
-                                          pose.root_location[None])[0]
+                                          pose.root_location[None], [scene.frame_current] if scene else None)[0]
             else:  # fallback bones (if any) as the viewport last evaluated them: one frame late
                 pose.quats = model.solve(pose.desired[None], self._evaluated(obj) if model.fallback else None)[0]
         apply_frame_pose(obj, pose)
