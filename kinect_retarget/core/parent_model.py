@@ -3,7 +3,7 @@ numpy for every frame at once (issue 15). Relations are learned from Blender's e
 (core/parent_fit.py); this module only applies them.
 
 Every bone the mapped bones hang from, and every bone those follow, has one relation giving its
-armature-space rotation R (quaternions, (F, 4)):
+armature-space rotation R for every frame:
 
     plain      R_c = R_p · L_c                        L_c: rest rotation relative to the parent times the
                                                       bone's own (constant) pose rotation
@@ -78,7 +78,8 @@ class ParentModel:
     fallback: tuple[int, ...]
     order: tuple[int, ...]
     error_deg: float = 0.0           # worst disagreement with Blender on the probe's poses
-    notes: dict = field(default_factory=dict)
+    notes: dict = field(default_factory=dict)          # what learning found (per-bone errors)
+    _plan_cache: dict = field(default_factory=dict, repr=False)
 
     @property
     def fallback_names(self) -> list[str]:
@@ -92,7 +93,8 @@ class ParentModel:
         """The bones whose rotation matters (mapped, constrained, followed), each as (bone, anchor, C):
         its parent's rotation is R_anchor · C (anchor -1: C alone; C None: identity), as 3x3 matrices. Plain
         bones in between fold into C, so a frame costs a few matrix products per bone that matters."""
-        if self.notes.get("plan") is None:
+        cache = self._plan_cache
+        if not cache:
             key = set(self.mapped) | set(self.follows) | set(self.fallback) | \
                 {f.target for f in self.follows.values() if f.target >= 0}
             local = to_matrix(normalize(self.local))
@@ -109,10 +111,9 @@ class ParentModel:
                     plan.append((b, anchor, c))
                 else:
                     carry[b] = (anchor, local[b] if c is None else c @ local[b])
-            self.notes["plan"] = plan
-            self.notes["local_m"] = local
-            self.notes["offset_m"] = {b: to_matrix(normalize(f.offset)) for b, f in self.follows.items()}
-        return self.notes["plan"]
+            cache.update(plan=plan, local=local,
+                         offset={b: to_matrix(normalize(f.offset)) for b, f in self.follows.items()})
+        return cache["plan"]
 
     def run(self, nframes: int, desired: np.ndarray | None = None, basis: np.ndarray | None = None,
             evaluated: dict | None = None, rotations: bool = True) -> tuple[dict, np.ndarray]:
@@ -122,7 +123,7 @@ class ParentModel:
         (F, M, 4) (checking against Blender). evaluated: fallback bone -> (F, 4) rotation relative to its
         parent, from Blender."""
         plan = self._plan()
-        local, offset = self.notes["local_m"], self.notes["offset_m"]
+        local, offset = self._plan_cache["local"], self._plan_cache["offset"]
         slot = {b: k for k, b in enumerate(self.mapped)}
         given = to_matrix(desired if desired is not None else basis)        # (F, M, 3, 3)
         pose = np.empty_like(given)
@@ -134,6 +135,8 @@ class ParentModel:
                 frame = local[b] if base is None else base @ local[b]
                 pose[:, k] = np.swapaxes(frame, -1, -2) @ given[:, k]
                 r = given[:, k]           # what the pose rotation was solved for
+                if evaluated is not None and b in evaluated:  # its own constraints turn it further
+                    r = to_matrix(evaluated[b]) if base is None else base @ to_matrix(evaluated[b])
             else:
                 if k is not None:
                     pose[:, k] = given[:, k]

@@ -26,7 +26,7 @@ def random_quats(rng, *shape):
 
 def blender(truth: ParentModel, basis, rng, noise=True):
     """'Evaluated' rotations (S, B, 4) of the true relations, rounded to float32 as Blender's are."""
-    rot, _ = truth.run(len(basis), basis=basis, evaluated=truth.notes.get("evaluated"))
+    rot, _ = truth.run(len(basis), basis=basis)
     out = np.stack([rot[b] for b in range(len(NAMES))], axis=1)
     return normalize(out.astype(np.float32).astype(np.float64)) if noise else out
 

@@ -204,21 +204,6 @@ def solve_frames(evaluator: ArmatureEvaluator | None, model: ParentModel, desire
     return make_continuous(out, axis=0)
 
 
-def check_against(evaluator: ArmatureEvaluator, model: ParentModel, quats: np.ndarray,
-                  desired: np.ndarray, frames=None) -> float:
-    """Worst angle, degrees, between the mapped bones' desired rotations and what Blender evaluates on the
-    copy for the pose quats (F, M, 4) (tests and benchmarks)."""
-    names = [model.rig.bone_names[b] for b in model.mapped]
-    worst = 0.0
-    for f in range(quats.shape[0]):
-        ev = evaluator.evaluate(names, quats[f], frame=None if frames is None else int(frames[f]))
-        got = ev[list(model.mapped)]
-        worst = max(worst, float(np.degrees(angle_between(got, desired[f]).max())))
-    return worst
-
-
-
-
 def solve_baked(obj: bpy.types.Object, rig: TargetRig, motion, switches: dict[str, float] | None = None,
                 progress=None) -> ParentModel:
     """The bake on a rig with constrained parents: probe, then motion.quats from motion.extras['desired']
