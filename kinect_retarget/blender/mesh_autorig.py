@@ -268,7 +268,11 @@ def autorig_to_file(mesh: Mesh, out_path: str, *, take=None, render_dir: str | N
     if take is not None:
         from .bake_take import bake_take
         messages: list[str] = []
-        result = bake_take(arm, take, preset="kinect", report=lambda level, msg: messages.append(msg))
+        from ..core.bake_options import BakeOptions
+        # our own new scene (like bake_to_file's): it runs at the take's rate over exactly the baked frames
+        scene.frame_start = scene.frame_end = 1
+        result = bake_take(arm, take, preset="kinect", report=lambda level, msg: messages.append(msg),
+                           options=BakeOptions(set_scene_fps=True, extend_scene_range=True))
         first, last = result.frame_range
         render_frames = sorted({int(f) for f in np.linspace(first, last, max(1, frames))})
         out.update({"action": result.action.name, "frames": len(result.motion.frames),
