@@ -27,6 +27,8 @@ from ..io.armature_probe import ArmatureEvaluator, constrained_summary, probe_pa
 from ..io.pose_apply import apply_frame_pose
 from ..io.rig_reader import fk_switch_bones, has_constrained_ancestry
 from ..ui.bake_settings import recording_bake_options
+from ..ui.takes_list import add_take
+from . import record_countdown
 from .rig_state import restore_rig_state, save_rig_state, switch_limbs_to_fk
 from .undo_step import push_undo_step
 
@@ -206,6 +208,8 @@ class LiveController:
             self.post("WARNING", "Recording stopped: no frame was recorded")
             return None
         self.post("INFO", f"Recorded {frames} frames to {path}")
+        if self.scene() is not None:
+            add_take(self.scene(), path)
         if bake and self._bake(path, rec) and undo_step:
             push_undo_step()
         return path
@@ -275,6 +279,7 @@ class LiveController:
             bake = self.bake_on_stop()
         session = self.session
         session.stop()
+        record_countdown.cancel()  # stopping live calls off a recording not yet started
         self.release_evaluator()
         baked_before = self.baked_action
         if self.recording is not None:

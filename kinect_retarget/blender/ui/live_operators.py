@@ -6,7 +6,7 @@ import bpy
 
 from ...core.take import TakeError
 from ...sources import SourceError
-from ..live import live_runtime
+from ..live import live_runtime, record_countdown
 from .properties import target_armature
 
 
@@ -89,6 +89,24 @@ class KINECT_RETARGET_OT_live_stop(bpy.types.Operator):
         return {"FINISHED"}
 
 
+def _record_after_countdown() -> None:
+    """The countdown's end (a timer, whose context has no window): record as the Record button would."""
+    c = live_runtime.controller()
+    if c is None:
+        return
+    wm = bpy.context.window_manager
+    window = bpy.context.window or (wm.windows[0] if wm is not None and len(wm.windows) else None)
+    try:
+        if window is not None and bpy.context.window is None:
+            with bpy.context.temp_override(window=window, screen=window.screen):
+                c.start_recording(bpy.context)
+        else:
+            c.start_recording(bpy.context)
+    except (SourceError, OSError) as exc:
+        c.post("ERROR", str(exc))
+    live_runtime.redraw_3d_views()
+
+
 class KINECT_RETARGET_OT_record(bpy.types.Operator):
     """Start recording the live frames to a take, or stop and bake the recording onto the rig"""
     bl_idname = "kinect_retarget.record"
@@ -106,6 +124,14 @@ class KINECT_RETARGET_OT_record(bpy.types.Operator):
         c = live_runtime.controller()
         try:
             if c.recording is None:
+                if record_countdown.cancel():  # Record during the countdown calls it off
+                    self.report({"INFO"}, "Countdown cancelled: not recording")
+                    return {"FINISHED"}
+                seconds = int(context.scene.kinect_retarget.record_countdown)
+                if seconds:
+                    record_countdown.start(seconds, _record_after_countdown)
+                    self.report({"INFO"}, f"Recording starts in {seconds} s")
+                    return {"FINISHED"}
                 path = c.start_recording(context)
                 self.report({"INFO"}, f"Recording to {path}")
             else:

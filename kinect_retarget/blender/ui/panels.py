@@ -4,7 +4,7 @@ from __future__ import annotations
 import bpy
 
 from ..io.armature_probe import fallback_bones
-from ..live import live_runtime
+from ..live import live_runtime, record_countdown
 from ..live.osc_access import osc_host
 from .bake_settings import draw_bake_options
 from .preferences import get_preferences
@@ -52,8 +52,14 @@ class KINECT_RETARGET_PT_main(_KinectPanel, bpy.types.Panel):
         else:
             row.operator("kinect_retarget.live_start", text="Start Live", icon="PLAY")
         recording = st.get("state") == "recording"
-        row.operator("kinect_retarget.record", text="Stop Recording" if recording else "Record",
-                     icon="REC", depress=recording)
+        counting = record_countdown.label()
+        row.operator("kinect_retarget.record", icon="REC", depress=recording or bool(counting),
+                     text="Stop Recording" if recording else "Cancel Countdown" if counting else "Record")
+        if counting:
+            big = col.row()
+            big.alert = True
+            big.scale_y = 1.6
+            big.label(text=counting, icon="TIME")
         row = col.row(align=True)
         row.operator("kinect_retarget.calibrate", icon="ARMATURE_DATA")
         row.operator("kinect_retarget.bake_take", text="Bake Take…", icon="ACTION")
@@ -148,6 +154,7 @@ class KINECT_RETARGET_PT_options(_KinectPanel, bpy.types.Panel):
             col.prop(s, "exact_constrained")
         col = layout.column(heading="Recording")
         col.prop(s, "record_dir")
+        col.prop(s, "record_countdown")
         col.prop(s, "play_on_record")
         col.prop(s, "bake_on_stop")
 

@@ -10,6 +10,7 @@ from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProp
 
 from ...core.presets import PRESET_NAMES
 from ...core.retarget import ROOT_MODES
+from ..live.record_countdown import COUNTDOWN_ITEMS
 from .bake_settings import BakeOptionProps
 from .preferences import FILTER_ITEMS, SOURCE_ITEMS, get_preferences
 
@@ -29,6 +30,15 @@ class KinectRetargetBoneMap(bpy.types.PropertyGroup):
     bone: StringProperty(name="Bone", description="Bone of the target armature")
     joint: StringProperty(name="Joint", description="Kinect joint driving it (the joint at the bone's tail)")
     enabled: BoolProperty(name="Enabled", default=True, description="Drive this bone")
+
+
+class KinectRetargetTake(bpy.types.PropertyGroup):
+    """One recording of this .blend in the sidebar's takes list (the file stays where it was written)."""
+    name: StringProperty(name="Name", description="The take's file name without its extension")
+    path: StringProperty(name="File", subtype="FILE_PATH")
+    seconds: FloatProperty(name="Length", unit="TIME_ABSOLUTE")
+    frames: IntProperty(name="Frames")
+    date: StringProperty(name="Recorded", description="When the recording stopped (local time)")
 
 
 class KinectRetargetSettings(bpy.types.PropertyGroup, BakeOptionProps):
@@ -54,6 +64,11 @@ class KinectRetargetSettings(bpy.types.PropertyGroup, BakeOptionProps):
     record_dir: StringProperty(name="Folder", subtype="DIR_PATH", default="//kinect_takes/")
     play_on_record: BoolProperty(name="Play Timeline", default=True,
                                  description="Start timeline playback when recording starts (keeps audio in sync)")
+    record_countdown: EnumProperty(name="Countdown", items=COUNTDOWN_ITEMS, default="0",
+                                   description="Seconds to wait after Record before recording starts (time to walk "
+                                               "into the sensor's view)")
+    takes: CollectionProperty(type=KinectRetargetTake)
+    takes_index: IntProperty(default=0)
     bake_on_stop: BoolProperty(name="Bake on Stop", default=True,
                                description="Bake the recording to an Action on the rig when recording stops")
 
@@ -87,4 +102,4 @@ def unregister_extra() -> None:
     del bpy.types.Scene.kinect_retarget
 
 
-CLASSES = (KinectRetargetBoneMap, KinectRetargetSettings)
+CLASSES = (KinectRetargetBoneMap, KinectRetargetTake, KinectRetargetSettings)
