@@ -17,6 +17,7 @@ import time
 from pathlib import Path
 
 import _common
+
 from kinect_retarget.core.take import TakeError
 from kinect_retarget.takes import bvh
 from tests.takes import baked_figure
@@ -56,7 +57,7 @@ def main() -> None:
                 take = bvh.read(plain(path, Path(tmp)), min_range=None)
                 dt = time.perf_counter() - t0
             except TakeError as exc:
-                print(f"{str(rel):58s} refused: {exc}")
+                print(f"{rel!s:58s} refused: {exc}")
                 continue
             meta = take.metadata
             joints, _ = baked_figure.bake(take)
@@ -65,9 +66,9 @@ def main() -> None:
                 "delta" if "added" in meta["bvh_position_channels"] else "root")
             mapping = meta["bvh_mapping"]
             summary = ", ".join(f"{SHORT[j]}={mapping[j].split(' (')[0]}" for j in SHORT)
-            print(f"{str(rel):58s} {take.frame_count:6d} {meta['bvh_unit'].split(' (')[0]:12s} "
+            print(f"{rel!s:58s} {take.frame_count:6d} {meta['bvh_unit'].split(' (')[0]:12s} "
                   f"{meta['bvh_up_axis']:3s} {mode:8s} {meta['bvh_standing_height_m']:7.3f} "
-                  f"{fig['head_to_foot_m']:7.3f} {str(fig['upright']):7s} {dt:6.3f}  {summary}")
+                  f"{fig['head_to_foot_m']:7.3f} {fig['upright']!s:7s} {dt:6.3f}  {summary}")
             for w in meta.get("warnings", ()):
                 print(f"{'':58s} warning: {w}")
             if args.mapping:

@@ -46,7 +46,7 @@ FINGER = 0.015      # a finger base at least this far from the wrist stands for 
 ARM_BRANCH = 0.2    # and the two arms at least this much (breasts and other helpers are shorter)
 STILL_DEG = 0.5     # a node whose chain never bends more than this over the take is a twist node
 TWIST_NAME = re.compile(r"twist|roll|upperarm0?2|lowerarm0?2|upperleg0?2|lowerleg0?2|helper|adjust|share",
-                        re.I)
+                        re.IGNORECASE)
 
 
 class StructureError(ValueError):

@@ -23,14 +23,25 @@ from ..core.skeletons import INFERRED, KINECT_V1, TRACKED
 from ..core.structure_mapping import StructureMapping
 from ..core.take import Take, TakeError
 from . import bvh_names
-from .bvh_figure import choose_unit, height_warning, kinect_joints, map_figure, standing_height
-from .bvh_fk import DELTA, POSITION_MODES, _axis_rotations, axis_quaternions, forward_kinematics, \
-    position_channel_mode
 from ._screening import screen_joints
+from .bvh_figure import choose_unit, height_warning, kinect_joints, map_figure, standing_height
+from .bvh_fk import DELTA, POSITION_MODES, _axis_rotations, axis_quaternions, forward_kinematics, position_channel_mode
 from .bvh_parse import BvhSkeleton, looks_like, read_bvh_text
 
-__all__ = ["read", "read_bvh_skeleton", "kinect_joints_lab", "virtual_kinect", "VirtualKinect", "BvhMotion",
-           "BvhSkeleton", "looks_like", "forward_kinematics", "axis_quaternions", "_axis_rotations", "describe"]
+__all__ = [
+    "BvhMotion",
+    "BvhSkeleton",
+    "VirtualKinect",
+    "_axis_rotations",
+    "axis_quaternions",
+    "describe",
+    "forward_kinematics",
+    "kinect_joints_lab",
+    "looks_like",
+    "read",
+    "read_bvh_skeleton",
+    "virtual_kinect",
+]
 
 DEFAULT_CAMERA_DISTANCE = 3.0  # metres in front of the performer's start
 DEFAULT_CAMERA_HEIGHT = 0.8    # metres above the floor: a Kinect on a low table or TV stand

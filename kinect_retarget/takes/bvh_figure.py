@@ -70,7 +70,7 @@ def choose_unit(height_units: float, family: str | None, scale: float | None, pa
         return 1.0, "metres (assumed: the figure has no height)"
     known = bvh_names.FAMILY_UNITS.get(family)
     if known and HEIGHT_RANGE[0] <= height_units * known <= HEIGHT_RANGE[1]:
-        name = dict((s, n) for s, n in UNITS).get(known, f"{known:g} m per unit")
+        name = dict(UNITS).get(known, f"{known:g} m per unit")
         return known, f"{name} ({family} joint names)"
     s, name = min(UNITS, key=lambda u: abs(np.log(height_units * u[0] / NOMINAL_HEIGHT)))
     return s, f"{name} (guessed from the standing height, {height_units:.4g} units)"

@@ -123,9 +123,8 @@ def parse_hierarchy(path: str, lines: list[str]) -> tuple[BvhSkeleton, int]:
         where = f"{path}:{i + 1}"
         if not b.names and key == "HIERARCHY":
             continue
-        if i == 0 or (not b.names and key not in ("ROOT", "JOINT")):
-            if key != "HIERARCHY":
-                raise TakeError(f"{where}: not a BVH file (first line should be HIERARCHY)")
+        if i == 0 or (not b.names and key not in ("ROOT", "JOINT")):  # (a HIERARCHY line was skipped above)
+            raise TakeError(f"{where}: not a BVH file (first line should be HIERARCHY)")
         if key in ("ROOT", "JOINT") or (key == "END" and len(tok) > 1 and tok[1].upper() == "SITE"):
             b.joint(where, tok)
         elif key == "{":

@@ -52,7 +52,7 @@ def test_cli_bake_of_a_z_up_millimetre_bvh_stands_upright(bpy_empty, tmp_path):
 
 
 def test_cli_bake_scale_override_and_odd_size_warning(tmp_path):
-    r, out = _bake(tmp_path, "--scale", "0.01")
+    r, _ = _bake(tmp_path, "--scale", "0.01")
     assert r.returncode == 0, r.stderr
     assert "warning: the figure is 15.45 m tall with the unit 0.01 m per unit (given)" in r.stderr
     bad = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(BVH), "--out",

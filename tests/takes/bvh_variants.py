@@ -89,6 +89,15 @@ def without_hands(fig: Figure) -> Figure:
                    offsets=fig.offsets[keep], ends=ends[keep], local=fig.local[:, keep])
 
 
+def under_reference(fig: Figure) -> Figure:
+    """A 'Reference' root above the hips carrying the root motion (MotionBuilder, Unreal-style exports)."""
+    local = np.concatenate([np.broadcast_to(np.eye(3), (fig.local.shape[0], 1, 3, 3)), fig.local], axis=1)
+    parents = np.concatenate([[-1], np.where(fig.parents < 0, 0, fig.parents + 1)])
+    return replace(fig, names=["Reference", *fig.names], parents=parents,
+                   offsets=np.concatenate([np.zeros((1, 3)), np.where((fig.parents < 0)[:, None], 0.0, fig.offsets)]),
+                   ends=np.concatenate([[False], fig.ends]), local=local)
+
+
 def _zyx_degrees(m: np.ndarray) -> np.ndarray:
     """(..., 3) angles (Z, Y, X) in degrees with m = Rz @ Ry @ Rx."""
     y = np.arcsin(np.clip(-m[..., 2, 0], -1, 1))

@@ -10,7 +10,8 @@ import pytest
 from kinect_retarget.core.skeletons import INFERRED, KINECT_V1
 from kinect_retarget.core.take import TakeError
 from kinect_retarget.takes import bvh
-from tests.takes import baked_figure, bvh_variants as bv
+from tests.takes import baked_figure
+from tests.takes import bvh_variants as bv
 
 SOURCE = Path(__file__).resolve().parents[1] / "data" / "bvh" / "mixamo_freebvh.bvh"
 
@@ -25,6 +26,7 @@ VARIANTS = {  # name: (transform, write options, expected unit, up axis, positio
     "millimetres": (lambda f: bv.scaled(f, 10.0), {}, "millimetres", "+Y", "root only"),
     "inches": (lambda f: bv.scaled(f, 1 / 2.54), {}, "inches", "+Y", "root only"),
     "no_hands": (bv.without_hands, {}, "centimetres", "+Y", "root only"),
+    "reference_root": (bv.under_reference, {}, "centimetres", "+Y", "root only"),
     "joint_site_crlf": (bv.renamed, {"joint_site": True, "root_joint": True, "newline": "\r\n"},
                         "centimetres", "+Y", "root only"),
 }
@@ -80,9 +82,9 @@ def test_scale_overrides_the_guess_and_odd_sizes_warn(tmp_path, source_figure, r
     assert take.metadata["bvh_unit"].startswith("0.001 m per unit (given)") and "warnings" not in take.metadata
     np.testing.assert_allclose(take.positions, reference.positions, atol=2e-5)
     wrong = bvh.read(path, scale=0.01, min_range=None)  # a 17.6 m giant: read, but said out loud
-    assert wrong.metadata["warnings"] == [
+    assert wrong.metadata["warnings"] == [(
         "the figure is 17.55 m tall with the unit 0.01 m per unit (given): outside 1-2.3 m; "
-        "pass --scale (metres per file unit) to fix it"]
+        "pass --scale (metres per file unit) to fix it")]
 
 
 def test_layout_edge_cases(tmp_path, source_figure):
