@@ -1,4 +1,8 @@
-"""Which BVH joints stand for each Kinect v1 joint, per skeleton naming family.
+"""Known BVH naming families: which joints stand for each Kinect v1 joint, per family.
+
+The reader no longer maps by these tables (core/structure_mapping.py maps every skeleton by structure); they
+name the family a file belongs to (`metadata["bvh_family"]`, informational) and let a CMU-named skeleton keep
+CMU units (FAMILY_UNITS) when those give a plausible height.
 
 Each Kinect joint lists alternatives, tried in order; an alternative is a tuple of BVH joint names whose
 positions are averaged (e.g. the head centre is halfway between the head joint and its end site). End sites
