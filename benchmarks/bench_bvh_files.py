@@ -62,8 +62,8 @@ def main() -> None:
             meta = take.metadata
             joints, _ = baked_figure.bake(take)
             fig = baked_figure.heights(joints, take.skeleton)
-            mode = meta["bvh_position_channels"].split(" ")[2] if "full" in meta["bvh_position_channels"] else (
-                "delta" if "added" in meta["bvh_position_channels"] else "root")
+            reading = meta["bvh_position_channels"]
+            mode = "full" if "full local" in reading else ("delta" if "added" in reading else "root")
             mapping = meta["bvh_mapping"]
             summary = ", ".join(f"{SHORT[j]}={mapping[j].split(' (')[0]}" for j in SHORT)
             print(f"{rel!s:58s} {take.frame_count:6d} {meta['bvh_unit'].split(' (')[0]:12s} "
