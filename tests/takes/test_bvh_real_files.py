@@ -1,4 +1,4 @@
-"""Real BVH files from eight exporters (tests/data/bvh/README.md): each maps by structure onto the Kinect
+"""Real BVH files from nine sources (tests/data/bvh/README.md): each maps by structure onto the Kinect
 joints, with the right unit and up axis, and bakes an upright, human-sized figure that follows its joints."""
 from __future__ import annotations
 
