@@ -118,10 +118,15 @@ class _Mapper:
         if not self.size > 0:
             raise StructureError("all nodes sit at one point: no figure to map")
         self.reach = np.zeros(n)  # longest path from a node down to a leaf of its subtree
+        # ... counting only bones longer than SHORT: a chain of many small face or finger nodes counts little
+        self.long = np.where(self.seg >= SHORT * self.size, self.seg, 0.0)
+        self.bulk = np.zeros(n)
         for j in self.order[::-1]:
             if self.kids[j]:
                 self.reach[j] = max(self.reach[c] + self.seg[c] for c in self.kids[j])
+                self.bulk[j] = max(self.bulk[c] + self.long[c] for c in self.kids[j])
         self.notes: list[str] = []
+        self._extents: dict[tuple[int, int], float] = {}
 
     def _parents_first(self) -> list[int]:
         roots = [j for j, p in enumerate(self.parents) if p < 0]
@@ -136,8 +141,31 @@ class _Mapper:
 
     # ------------------------------------------------------------------------------------------ structure
 
+    def _extent(self, j: int, c: int) -> float:
+        """How far from j the subtree of its child c reaches (straight line: a winding chain of face or
+        finger nodes reaches less far than an arm)."""
+        key = (j, c)
+        if key not in self._extents:
+            sub, stack = [], [c]
+            while stack:
+                sub.append(stack.pop())
+                stack.extend(self.kids[sub[-1]])
+            d = np.linalg.norm(self.pos[:, sub] - self.pos[:, j, None], axis=-1)
+            self._extents[key] = float(np.median(d, axis=0).max())
+        return self._extents[key]
+
+    def _pair(self, j: int, branches: list[int]) -> tuple[int, int]:
+        """The left-right pair among j's branches: the longest two whose long bones add up to about the same
+        length (a neck with a head may reach further than one arm, but it has no twin)."""
+        size = {b: self.bulk[b] + self.long[b] for b in branches}
+        pairs = [(a, b) for i, a in enumerate(branches) for b in branches[i + 1:]
+                 if max(size[a], size[b]) <= 1.25 * min(size[a], size[b])]
+        if not pairs:
+            return tuple(sorted(branches, key=lambda b: -size[b])[:2])
+        return max(pairs, key=lambda p: min(size[p[0]], size[p[1]]))
+
     def _branches(self, j: int, frac: float) -> list[int]:
-        return [c for c in self.kids[j] if self.reach[c] + self.seg[c] >= frac * self.size]
+        return [c for c in self.kids[j] if self.bulk[c] + self.long[c] >= frac * self.size]
 
     def _descend_to_fork(self, j: int, frac: float, forks: int, long: float = 0.0) -> int | None:
         """Follow single big branches down from j to the first node with `forks` or more big branches, two of
@@ -256,19 +284,22 @@ class _Mapper:
         spines = [b for b in big if chests[b] is not None]
         if not spines:
             raise StructureError(f"no chest above {self.names[pelvis]!r}: no node where two arms and a neck meet")
-        spine = max(spines, key=lambda b: self.reach[b])
+        spine = max(spines, key=lambda b: self._extent(pelvis, b))
         chest = chests[spine]
-        legs = sorted((b for b in big if b != spine), key=lambda b: -self.reach[b])[:2]
+        legs = [b for b in big if b != spine]
         if len(legs) < 2:
             raise StructureError(f"{self.names[pelvis]!r} has one leg branch; a humanoid needs two")
-        arms_neck = sorted(self._branches(chest, NECK_BRANCH), key=lambda b: -(self.reach[b] + self.seg[b]))
-        arm_a, arm_b = arms_neck[0], arms_neck[1]
-        neck = arms_neck[2]
+        legs = list(self._pair(pelvis, legs))
+        branches = self._branches(chest, NECK_BRANCH)
+        arm_a, arm_b = self._pair(chest, branches)
+        neck = max((b for b in branches if b not in (arm_a, arm_b)), key=lambda b: self._extent(chest, b))
         leg_a, leg_b = (self._leg(pelvis, b) for b in legs)
         arm_a, arm_b = self._arm(chest, arm_a), self._arm(chest, arm_b)
-        head_chain = self._joints(self._chain(neck, chest))
-        top = max(head_chain[1:], key=lambda j: self._dist(chest, j))
-        head_chain = head_chain[:head_chain.index(top) + 1]
+        head = [neck]
+        for j in head:  # the neck branch's nodes; the top of the head is the one furthest from the chest
+            head.extend(self.kids[j])
+        top = max(head, key=lambda j: self._dist(chest, j))
+        head_chain = self._joints(self._path_up(top, chest))
         up_axis, up_sign = self._up(top, leg_a, leg_b)
         up = np.eye(3)[up_axis] * up_sign
         forward, a_is_left = self._facing(up, leg_a, leg_b, legs)
