@@ -20,6 +20,7 @@ from ..core.skeletons import Skeleton
 from ..core.take import Take
 from .io.action_writer import bake_motion, push_to_nla
 from .io.armature_probe import constrained_summary, solve_baked
+from .io.finger_rig import apply_hands, hands_on_rig
 from .io.kinect_rig import build_kinect_rig
 from .io.rig_reader import fk_switch_bones, has_constrained_ancestry, target_rig_from_object
 
@@ -133,6 +134,10 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
         model = solve_baked(obj, pipeline.rig, motion, {name: 1.0 for _, name, _ in extra},
                             (lambda f: progress(0.3 + 0.6 * f / n)) if progress else None)
         report({"INFO"}, constrained_summary(model))
+    fingers = []
+    if options.hands == "on" or (options.hands == "auto" and "HandTipLeft" in take.skeleton.joints):
+        fingers = apply_hands(motion, hands_on_rig(obj, pipeline.retargeter.mapped), take, take.skeleton.joints,
+                              settings.mirror)
     take_name = whole.metadata.get("name", "take")
     name = action_name or f"{obj.name}_{take_name}"
     reduction = _reduce(obj, motion, options)
@@ -146,6 +151,8 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
                      f"{part or 'whole take'}, {whole.rate:g} fps) for {len(motion.bone_names)} bones "
                      f"(preset {used}) onto {obj.name!r} as action {action.name!r}"
                      + (f", NLA strip {strip!r}" if strip else "") + f"; {scene_note}"
+                     + (f"; hands: {len(fingers)} finger bones keyed (thumb roll, hand-tip bend"
+                        f"{', hand states' if take.hand_states is not None else ''})" if fingers else "")
                      + (f"; key reduction removed {reduction.removed} keys (max error {reduction.max_deg:.3f}°, "
                         f"{reduction.max_mm:.3f} mm)" if reduction else "")
                      + (f"; left alone (the take has no position for their joints): {', '.join(skipped)}"

@@ -6,7 +6,7 @@ import os
 
 import numpy as np
 
-from ..core.bake_options import RANGE_UNITS, BakeOptions
+from ..core.bake_options import HAND_MODES, RANGE_UNITS, BakeOptions
 from ..core.filters import FILTERS
 from ..core.presets import PRESET_NAMES
 from ..core.retarget import ROOT_MODES
@@ -53,6 +53,9 @@ def add_bake_option_args(p) -> None:
     g.add_argument("--into-current", action="store_true",
                    help="key into the rig's current Action (its keys in the baked range are replaced)")
     g.add_argument("--nla", action="store_true", help="push the new Action to the NLA as a strip named after the take")
+    g.add_argument("--hands", choices=HAND_MODES, default="auto",
+                   help="Kinect v2 hands (thumb roll, hand-tip bend, hand-state curls) on rigs with finger bones; "
+                        "auto: on for v2 takes")
     g.add_argument("--set-scene-fps", action="store_true", help="set the rig file's scene to the key rate")
     g.add_argument("--extend-range", action="store_true",
                    help="grow the rig file's scene range to hold the keys (never shortens it)")
@@ -62,7 +65,7 @@ def bake_options_from_args(args) -> BakeOptions:
     return BakeOptions(range_start=args.take_start, range_end=args.take_end, range_unit=args.range_unit,
                        step=args.step, reduce=args.reduce, tolerance_deg=args.tolerance_deg,
                        tolerance_mm=args.tolerance_mm, into_current=args.into_current, push_nla=args.nla,
-                       set_scene_fps=args.set_scene_fps, extend_scene_range=args.extend_range)
+                       set_scene_fps=args.set_scene_fps, extend_scene_range=args.extend_range, hands=args.hands)
 
 
 BVH_FIELDS = {"bvh_unit": "unit", "bvh_standing_height_m": "standing_height_m", "bvh_up_axis": "up_axis",

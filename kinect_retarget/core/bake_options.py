@@ -10,6 +10,7 @@ import numpy as np
 from .take import Take, TakeError
 
 RANGE_UNITS = ("seconds", "frames")
+HAND_MODES = ("auto", "on", "off")  # auto: on for takes with Kinect v2's hand joints, off otherwise
 
 
 @dataclass(frozen=True)
@@ -25,12 +26,15 @@ class BakeOptions:
     push_nla: bool = False             # push the baked Action to the NLA as a strip named after the take
     set_scene_fps: bool = False        # run the scene at the bake's rate
     extend_scene_range: bool = False   # grow the scene's frame range to hold the keys (never shrinks it)
+    hands: str = "auto"                # thumb roll, hand-tip bend, hand-state curls on rigs with fingers
     keys_on_samples: bool = False      # key each sample at its nearest frame, no resampling (live's recording:
                                        # the baked keys equal the poses live showed)
 
     def __post_init__(self) -> None:
         if self.range_unit not in RANGE_UNITS:
             raise ValueError(f"unknown range unit {self.range_unit!r} (choose from {', '.join(RANGE_UNITS)})")
+        if self.hands not in HAND_MODES:
+            raise ValueError(f"unknown hands mode {self.hands!r} (choose from {', '.join(HAND_MODES)})")
         if self.step < 1:
             raise ValueError(f"key step must be at least 1 frame, got {self.step}")
         if self.reduce and not (self.tolerance_deg > 0 and self.tolerance_mm > 0):

@@ -25,6 +25,7 @@ class Take:
     rate: float
     source_format: str = "krtake"
     metadata: dict = field(default_factory=dict)
+    hand_states: np.ndarray | None = None  # (F, 2) Kinect v2 HandState of the left and right hand, when read
 
     def __post_init__(self) -> None:
         self.positions = np.asarray(self.positions, dtype=np.float64)
@@ -64,7 +65,8 @@ class Take:
 
     def slice(self, frames: slice | np.ndarray) -> "Take":
         return Take(self.skeleton, self.positions[frames], self.states[frames], self.times[frames], self.rate,
-                    self.source_format, dict(self.metadata))
+                    self.source_format, dict(self.metadata),
+                    None if self.hand_states is None else self.hand_states[frames])
 
 
 def nominal_rate(times: np.ndarray, default: float = 30.0) -> float:

@@ -82,7 +82,8 @@ def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
     positions, states = screen_joints(path, table[..., :3], states, records, meta, label="record",
                                       values_ok=np.all(np.isfinite(table[..., 3:7]), axis=2))
     table[states != before] = np.nan  # dropped samples: their 2D values are not to be trusted either
-    take = Take(KINECT_V2, positions, states, times_s, nominal_rate(times_s), "kinectron_json", meta)
+    take = Take(KINECT_V2, positions, states, times_s, nominal_rate(times_s), "kinectron_json", meta,
+                hands.astype(np.uint8))
     depth_px, color_px = table[..., 3:5] * DEPTH_SIZE, table[..., 5:7] * COLOR_SIZE
     two_d = {
         "depth": table[..., 3:5], "color": table[..., 5:7], "depth_px": depth_px, "color_px": color_px,

@@ -13,6 +13,10 @@ DESTINATION_ITEMS = [
     ("CURRENT", "Current Action", "Key into the Action the rig plays now, replacing its keys in the baked range"),
     ("NLA", "NLA Strip", "Key a new Action and push it to the NLA as a strip named after the take"),
 ]
+HAND_ITEMS = [("auto", "Auto", "Hands for takes with Kinect v2's hand joints, none for Kinect v1"),
+              ("on", "On", "Roll the hand from the thumb, bend the fingers toward the hand tip, curl them from "
+                           "the hand states (open, fist, lasso)"),
+              ("off", "Off", "Leave the finger bones and the hand's roll alone")]
 RANGE_UNIT_ITEMS = [("seconds", "Seconds", "Take range in seconds from the take's start"),
                     ("frames", "Take Frames", "Take range in the take's own frames, counted from 0")]
 
@@ -40,6 +44,8 @@ class BakeOptionProps:
     tolerance_mm: FloatProperty(name="Location Tolerance (mm)", default=1.0, min=0.001, soft_max=50.0,
                                 description="Largest root-location error key reduction may leave, in millimetres")
     destination: EnumProperty(name="Keys Into", items=DESTINATION_ITEMS, default="NEW")
+    hands: EnumProperty(name="Hands", items=HAND_ITEMS, default="auto",
+                        description="Kinect v2 hands on rigs with finger bones (Rigify, Mixamo, UE Mannequin)")
 
 
 def options_from(owner) -> BakeOptions:
@@ -49,7 +55,8 @@ def options_from(owner) -> BakeOptions:
                        range_unit=owner.range_unit, step=owner.key_step, reduce=owner.reduce_keys,
                        tolerance_deg=owner.tolerance_deg, tolerance_mm=owner.tolerance_mm,
                        into_current=owner.destination == "CURRENT", push_nla=owner.destination == "NLA",
-                       set_scene_fps=owner.set_scene_fps, extend_scene_range=owner.extend_scene_range)
+                       set_scene_fps=owner.set_scene_fps, extend_scene_range=owner.extend_scene_range,
+                       hands=owner.hands)
 
 
 def recording_bake_options(scene) -> BakeOptions:
@@ -85,3 +92,4 @@ def draw_bake_options(layout, owner) -> None:
     sub.prop(owner, "tolerance_deg")
     sub.prop(owner, "tolerance_mm")
     layout.prop(owner, "destination")
+    layout.prop(owner, "hands")

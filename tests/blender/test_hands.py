@@ -1,0 +1,81 @@
+"""Kinect v2 hands on a rig with finger bones (Blender's Rigify human metarig): the hand rolls to the
+performer's thumb, the hand states curl the fingers smoothly, and Kinect v1 takes leave the fingers alone."""
+import numpy as np
+import pytest
+
+from kinect_retarget.core.bake_options import BakeOptions
+from kinect_retarget.core.conventions import kinect_to_blender
+from kinect_retarget.core.hand_pose import CLOSED, OPEN
+from kinect_retarget.core.pipeline import RetargetSettings
+from kinect_retarget.core.quat import angle_between
+from kinect_retarget.takes import load_take
+
+
+@pytest.fixture
+def metarig(bpy_empty):
+    import addon_utils
+    addon_utils.enable("rigify", default_set=True)
+    bpy_empty.ops.object.armature_human_metarig_add()
+    return bpy_empty.context.object
+
+
+def _bake(obj, take, hands="auto"):
+    from kinect_retarget.blender.bake_take import bake_take
+    messages = []
+    res = bake_take(obj, take, preset="auto", settings=RetargetSettings(filter="none", fps=take.rate),
+                    options=BakeOptions(hands=hands), report=lambda level, msg: messages.append(msg))
+    return res, messages[-1]
+
+
+def _thumb_side_errors(bpy, obj, res, take):
+    """Degrees between the hand's thumb side (its rest thumb side carried by the posed hand) and the
+    performer's hand -> thumb, both seen across the hand's own axis."""
+    from kinect_retarget.blender.io.finger_rig import hand_rig
+    p = kinect_to_blender(res.motion.extras["positions"])
+    sk = take.skeleton
+    rigs = {side: hand_rig(obj, f"hand.{side[0]}", side) for side in ("Left", "Right")}
+    errs = []
+    for i in range(0, len(res.motion.frames), 3):
+        bpy.context.scene.frame_set(int(res.motion.frames[i]))
+        for side, rig in rigs.items():
+            m = np.array(obj.pose.bones[rig.hand].matrix)[:3, :3]
+            m /= np.linalg.norm(m, axis=0)
+            y = m[:, 1]
+            a, b = m @ rig.thumb_local, p[i, sk.index(f"Thumb{side}")] - p[i, sk.index(f"Hand{side}")]
+            a, b = a - (a @ y) * y, b - (b @ y) * y
+            errs.append(np.degrees(np.arccos(np.clip(a @ b / np.linalg.norm(a) / np.linalg.norm(b), -1, 1))))
+    return np.array(errs)
+
+
+def test_v2_hands_roll_to_the_thumb_and_curl_from_hand_states(metarig, shared_data):
+    bpy = __import__("bpy")
+    take = load_take(shared_data / "kinect_v2" / "recorded_skeleton.json")
+    assert take.hand_states is not None
+    res, msg = _bake(metarig, take)
+    assert "hands: 30 finger bones keyed" in msg and "hand states" in msg
+    on = _thumb_side_errors(bpy, metarig, res, take)
+    m = res.motion
+    # curls: the middle finger's reach (base to tip) is short in a fist, long with the hand open
+    reach = {OPEN: [], CLOSED: []}
+    for i in range(len(m.frames)):
+        state = int(take.hand_states[m.samples[i], 0])
+        if state in reach and i > 10 and int(take.hand_states[m.samples[i - 10], 0]) == state:  # settled
+            bpy.context.scene.frame_set(int(m.frames[i]))
+            pb = metarig.pose.bones
+            reach[state].append(np.linalg.norm(np.array(pb["f_middle.03.L"].tail) - np.array(pb["f_middle.01.L"].head)))
+    assert reach[OPEN] and reach[CLOSED] and np.mean(reach[CLOSED]) < 0.7 * np.mean(reach[OPEN])
+    # smooth: no finger joint turns by more than 25 degrees from one key to the next
+    k = m.bone_names.index("f_middle.02.L")
+    assert np.degrees(angle_between(m.quats[1:, k], m.quats[:-1, k])).max() < 25.0
+    off, msg_off = _bake(metarig, take, hands="off")
+    assert "hands:" not in msg_off and "f_middle.02.L" not in off.motion.bone_names
+    without = _thumb_side_errors(bpy, metarig, off, take)
+    print(f"thumb side error: hands on median {np.median(on):.2f}° p90 {np.percentile(on, 90):.1f}°, "
+          f"off median {np.median(without):.1f}° p90 {np.percentile(without, 90):.1f}°")
+    assert np.median(on) < 1.0 and np.median(without) > 10.0
+
+
+def test_v1_takes_leave_the_fingers_alone(metarig):
+    take = load_take("sample_takes/kinect_v1_cmu_131_03_hop.krtake").slice(slice(0, 30))
+    res, msg = _bake(metarig, take)
+    assert "hands:" not in msg and not any(b.startswith(("f_", "thumb")) for b in res.motion.bone_names)
