@@ -65,7 +65,7 @@ def test_blender_bvh_export_reads_back_as_the_same_figure(tmp_path):
     their tail joint) through `bake --out x.bvh`, read back: the same limbs as the source."""
     from kinect_retarget.takes import bvh
     from tests.takes import baked_figure
-    src = BVH.parent / "mocapbank_walk.bvh"
+    src = BVH.parent / "mocapbank_sit_down.bvh"
     out = tmp_path / "exported.bvh"
     r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(src), "--out", str(out), "--filter",
                         "none", "--take-end", "59", "--range-unit", "frames"], capture_output=True, text=True)

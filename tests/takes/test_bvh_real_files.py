@@ -19,7 +19,7 @@ EXPECTED = {
                                          "HipRight": "RightUpLeg", "FootRight": "RightToeBase"}),
     "cmu_131_03.bvh": ("CMU units", "+Y", {"ShoulderLeft": "LeftShoulder", "ElbowLeft": "LeftElbow",
                                           "KneeRight": "RightKnee", "FootLeft": "LeftToe"}),
-    "mocapbank_walk.bvh": ("centimetres", "+Y", {"WristLeft": "LeftWrist", "HandLeft": "LeftWrist_end",
+    "mocapbank_sit_down.bvh": ("centimetres", "+Y", {"WristLeft": "LeftWrist", "HandLeft": "LeftWrist_end",
                                                  "ShoulderRight": "RightShoulder", "AnkleLeft": "LeftAnkle"}),
     "mixamo_freebvh.bvh": ("centimetres", "+Y", {"HandRight": "mixamorig:RightHandMiddle1",
                                                  "Head": "mixamorig:Head + mixamorig:HeadTop_End"}),
@@ -77,7 +77,7 @@ def test_position_channels_read_per_file():
 def test_left_is_left_toes_point_forward():
     """The performer faces the virtual sensor: toes nearer to it than ankles, left hand on the sensor's right."""
     k = KINECT_V1.index
-    for name in ("cmu_01_01.bvh", "mixamo_freebvh.bvh", "univrm_sample.bvh", "mocapbank_walk.bvh"):
+    for name in ("cmu_01_01.bvh", "mixamo_freebvh.bvh", "univrm_sample.bvh", "mocapbank_sit_down.bvh"):
         p = bvh.read(DATA / name, min_range=None).positions[0]
         assert p[k("FootLeft"), 2] < p[k("AnkleLeft"), 2] and p[k("FootRight"), 2] < p[k("AnkleRight"), 2], name
         assert p[k("ShoulderLeft"), 0] < p[k("ShoulderRight"), 0], name
