@@ -9,6 +9,21 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 SAMPLE_TAKES = REPO / "sample_takes"
+TESTS = Path(__file__).resolve().parent
+# Tiers (markers registered in pytest.ini; `make test-core` deselects bpy, slow and network): folders whose
+# tests need the bpy wheel, and folders whose tests render depth, build meshes, stream the emulated Kinect or
+# track images (seconds each). Tests that open sockets carry @pytest.mark.network themselves.
+BPY_FOLDERS = ("blender",)
+SLOW_FOLDERS = ("depth", "autorig", "device", "lift")
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        folder = Path(str(item.fspath)).resolve().relative_to(TESTS).parts[0]
+        if folder in BPY_FOLDERS:
+            item.add_marker(pytest.mark.bpy)
+        if folder in SLOW_FOLDERS:
+            item.add_marker(pytest.mark.slow)
 
 
 @pytest.fixture(scope="session")

@@ -41,7 +41,7 @@ class BakeOptions:
             raise ValueError("key reduction needs positive tolerances in degrees and millimetres")
         if self.into_current and self.push_nla:
             raise ValueError("choose one: key into the current Action or push a new one to the NLA")
-        if None not in (self.range_start, self.range_end) and self.range_end < self.range_start:
+        if self.range_start is not None and self.range_end is not None and self.range_end < self.range_start:
             raise ValueError(f"take range ends ({self.range_end}) before it starts ({self.range_start})")
 
 

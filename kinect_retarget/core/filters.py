@@ -54,7 +54,8 @@ class DoubleExponentialFilter:
             self._raw, self._out = x.copy(), x.copy()
             self._count = np.zeros((n, 1))
         count = self._count
-        prev_f, prev_t = self._filtered, self._trend
+        prev_f, prev_t, raw, out = self._filtered, self._trend, self._raw, self._out
+        assert raw is not None and out is not None   # set together with _filtered
         first = count == 0
         second = count == 1
         # jitter radius: small moves are pulled toward the last estimate in proportion to their size
@@ -63,7 +64,7 @@ class DoubleExponentialFilter:
         w = np.minimum(dist / self.jitter_radius, 1.0)
         damped = prev_f + diff * w
         filtered = damped * (1 - self.smoothing) + (prev_f + prev_t) * self.smoothing
-        filtered = np.where(second, (x + self._raw) * 0.5, filtered)
+        filtered = np.where(second, (x + raw) * 0.5, filtered)
         filtered = np.where(first, x, filtered)
         trend = (filtered - prev_f) * self.correction + prev_t * (1 - self.correction)
         trend = np.where(first, 0.0, trend)
@@ -74,8 +75,8 @@ class DoubleExponentialFilter:
         predicted = np.where(over, x + dev * (self.max_deviation / np.maximum(dlen, 1e-12)), predicted)
         self._filtered = np.where(valid, filtered, prev_f)
         self._trend = np.where(valid, trend, 0.0)
-        self._raw = np.where(valid, x, self._raw)
-        self._out = np.where(valid, predicted, self._out)
+        self._raw = np.where(valid, x, raw)
+        self._out = np.where(valid, predicted, out)
         self._count = np.where(valid, count + 1, 0.0)
         return self._out.copy()
 
@@ -136,10 +137,12 @@ class OneEuroFilter:
             self._x = self._x + diff
             self._dx = dx_hat
             return
-        x_hat = self._x + diff
+        x_prev = self._x
+        assert x_prev is not None   # set by the first step
+        x_hat = x_prev + diff
         restart = valid & ~self._seen  # a joint coming back starts from its raw position
         x_hat = np.where(restart, x, x_hat)
-        self._x = np.where(valid, x_hat, self._x)
+        self._x = np.where(valid, x_hat, x_prev)
         self._dx = np.where(valid & ~restart, dx_hat, 0.0)
         self._seen = valid
 

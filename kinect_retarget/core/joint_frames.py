@@ -17,7 +17,7 @@ The same rules build the target rig's rest frames from its rest joint positions,
 """
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -160,7 +160,7 @@ def limb_hint(get: GetJoint, side: str, kind: str, level: int, y: np.ndarray, wo
     for i in range(1, level + 1):
         prev = y_upper if i == 1 else dirs[i - 1]
         cur = y if i == level or dirs[i] is None else dirs[i]
-        if prev is None:
+        if prev is None or cur is None:
             break
         hint = rotate_minimal(hint, normalize(prev), normalize(cur))
     return hint

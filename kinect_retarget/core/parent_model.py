@@ -35,7 +35,7 @@ class Follow:
     weight: float
 
 
-def slerp_toward(a: np.ndarray, b: np.ndarray, w: float) -> np.ndarray:
+def slerp_toward(a: np.ndarray, b: np.ndarray, w: float | np.ndarray) -> np.ndarray:
     """Blender's influence blend: a turned the shortest way toward b by the fraction w (broadcasts)."""
     rel = mul(conjugate(a), b)
     rel = rel * np.where(rel[..., :1] < 0, -1.0, 1.0)  # shortest way round, as interp_qt_qtqt
@@ -58,6 +58,7 @@ def local_rotations(rig: TargetRig, basis: np.ndarray) -> np.ndarray:
     inherit rotation) times its pose rotation `basis` (B, 4)."""
     rot = rig.rest[:, :3, :3]
     rel = rot.copy()
+    assert rig.inherit_rotation is not None   # TargetRig fills it in
     has = (rig.parents >= 0) & rig.inherit_rotation
     rel[has] = np.swapaxes(rot[rig.parents[has]], -1, -2) @ rot[has]
     return normalize(mul(from_matrix(rel), basis))  # rest matrices come as float32: exactly unit here
@@ -125,7 +126,9 @@ class ParentModel:
         plan = self._plan()
         local, offset = self._plan_cache["local"], self._plan_cache["offset"]
         slot = {b: k for k, b in enumerate(self.mapped)}
-        given = to_matrix(desired if desired is not None else basis)        # (F, M, 3, 3)
+        mapped_q = desired if desired is not None else basis
+        assert mapped_q is not None, "give desired or basis"
+        given = to_matrix(mapped_q)        # (F, M, 3, 3)
         pose = np.empty_like(given)
         out: dict[int, np.ndarray] = {}
         for b, anchor, c in plan:

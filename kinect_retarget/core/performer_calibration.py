@@ -40,7 +40,7 @@ class Calibration:
         return json.dumps(asdict(self))
 
     @classmethod
-    def from_json(cls, text: str) -> "Calibration":
+    def from_json(cls, text: str) -> Calibration:
         try:
             data = json.loads(text)
             if data.get("version") != 1 or data.get("skeleton") not in SKELETONS:

@@ -14,6 +14,7 @@ is never changed. The root bone's head follows the root joint's displacement tim
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal, overload
 
 import numpy as np
 
@@ -183,6 +184,15 @@ class Retargeter:
         if self.rig.generated or not source_leg or not self.target_leg:
             return 1.0
         return self.target_leg / source_leg
+
+    @overload
+    def solve(self, positions: np.ndarray, root_reference: np.ndarray | None = ...,
+              source_leg: float | None = ..., want_desired: Literal[False] = ...) -> tuple[np.ndarray, np.ndarray]: ...
+
+    @overload
+    def solve(self, positions: np.ndarray, root_reference: np.ndarray | None = ...,
+              source_leg: float | None = ..., *,
+              want_desired: Literal[True]) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
 
     def solve(self, positions: np.ndarray, root_reference: np.ndarray | None = None,
               source_leg: float | None = None, want_desired: bool = False):

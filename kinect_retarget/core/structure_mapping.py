@@ -286,6 +286,7 @@ class _Mapper:
             raise StructureError(f"no chest above {self.names[pelvis]!r}: no node where two arms and a neck meet")
         spine = max(spines, key=lambda b: self._extent(pelvis, b))
         chest = chests[spine]
+        assert chest is not None   # spines holds only branches with a chest
         legs = [b for b in big if b != spine]
         if len(legs) < 2:
             raise StructureError(f"{self.names[pelvis]!r} has one leg branch; a humanoid needs two")
@@ -380,7 +381,8 @@ class _Mapper:
         if base is None:
             base = head_chain[-2] if len(head_chain) >= 3 else top
         roles["Head"] = RoleMatch(base, (base, top) if base != top else (top,),
-                                  "between the head joint and the top of the head" if base != top else "top of the neck")
+                                  "between the head joint and the top of the head" if base != top
+                                  else "top of the neck")
         for side, arm, leg in (("Left", arm_l, leg_l), ("Right", arm_r, leg_r)):
             for part in ("Shoulder", "Elbow", "Wrist"):
                 roles[part + side] = RoleMatch(arm[part], (arm[part],), f"{part.lower()} of the {side.lower()} arm")

@@ -63,7 +63,7 @@ class Take:
         """(F,) True for frames where at least one joint is tracked or inferred."""
         return np.any(self.states != NOT_TRACKED, axis=1)
 
-    def slice(self, frames: slice | np.ndarray) -> "Take":
+    def slice(self, frames: slice | np.ndarray) -> Take:
         return Take(self.skeleton, self.positions[frames], self.states[frames], self.times[frames], self.rate,
                     self.source_format, dict(self.metadata),
                     None if self.hand_states is None else self.hand_states[frames])

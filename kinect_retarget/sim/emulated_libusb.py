@@ -172,7 +172,6 @@ class EmulatedLibusb:
         if stream.id != self._stream_id:
             self._stream_id, self._next = stream.id, 0
         start = microframe(stream.start_time)
-        faults = self._dev.faults
         while True:
             i = self._next
             due = start + packet_microframe(i)

@@ -10,10 +10,9 @@ from __future__ import annotations
 import queue
 import threading
 
-
 from ..core.skeletons import KINECT_V1
-from ..device.protocol import TIMESTAMP_HZ, TIMESTAMP_WRAP
 from ..depth.skeleton_tracker import SkeletonTracker
+from ..device.protocol import TIMESTAMP_HZ, TIMESTAMP_WRAP
 
 
 class DepthSkeletonProducer:

@@ -12,8 +12,8 @@ import time
 import numpy as np
 
 from ..core.skeletons import NOT_TRACKED, Skeleton
-from .skeleton_frame import SkeletonFrame
 from .frame_queue import FrameQueue
+from .skeleton_frame import SkeletonFrame
 
 
 class SourceError(RuntimeError):

@@ -144,7 +144,7 @@ class OscReceiver(FrameSource):
         while not self.stopping:
             try:
                 data, sender = sock.recvfrom(65536)
-            except socket.timeout:
+            except TimeoutError:
                 continue
             except OSError as exc:
                 if self.stopping:

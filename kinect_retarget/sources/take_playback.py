@@ -31,7 +31,7 @@ class TakePlayback(FrameSource):
 
     def _load(self) -> Take:
         from ..takes import load_take
-        if not os.path.isfile(self.path):
+        if self.path is None or not os.path.isfile(self.path):
             raise SourceError(f"take file {self.path} does not exist")
         try:
             return load_take(self.path)

@@ -39,7 +39,7 @@ class UsbKinectSource(FrameSource):
         if self._producer is None:
             factory = self._factory
             if factory is None:
-                from .depth_skeletons import open_skeleton_producer   # numpy-heavy: only when the source starts
+                from .depth_skeletons import open_skeleton_producer  # numpy-heavy: only when the source starts
                 factory = open_skeleton_producer
             try:
                 self._producer = factory()

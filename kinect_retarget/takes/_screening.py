@@ -18,13 +18,14 @@ from ._numeric import at
 MAX_DISTANCE_M = 20.0  # a Kinect sees about 0.5-8 m; anything past 20 m is a corrupt value, not a person
 
 
-def screen_joints(path: str, positions: np.ndarray, states: np.ndarray, where: np.ndarray, meta: dict, *,
+def screen_joints(path: str, positions: np.ndarray, states: np.ndarray, where: np.ndarray | None, meta: dict, *,
                   label: str = "line", values_ok: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(positions, states) with every seen joint sample that is NaN, infinite or farther than
     MAX_DISTANCE_M from the sensor turned NOT_TRACKED (position NaN).
 
     positions (F, J, 3) Kinect camera space metres; states (F, J); `where` (F,) each frame's line (or
-    record) number in the file, or (F, J) each joint's, `label` the word for it; `values_ok` (F, J) optionally False where a joint's
+    record) number in the file, or (F, J) each joint's, `label` the word for it; `values_ok` (F, J)
+    optionally False where a joint's
     other values in the file (2D pixels, orientation) are NaN or infinite. Adds `dropped_joint_samples`,
     `first_dropped_<label>` and a warning to `meta` when anything was dropped. Raises TakeError when no
     frame keeps a usable joint.
@@ -37,6 +38,8 @@ def screen_joints(path: str, positions: np.ndarray, states: np.ndarray, where: n
         bad |= seen & ~values_ok
     if not bad.any():
         return positions, states
+    if where is None:   # no line numbers kept: name frames by their index
+        where = np.arange(positions.shape[0])
     rows = np.flatnonzero(bad.any(axis=1))
     first = int(where[rows[0]] if where.ndim == 1 else where.reshape(bad.shape)[np.unravel_index(
         np.argmax(bad), bad.shape)])

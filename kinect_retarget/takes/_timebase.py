@@ -31,7 +31,8 @@ def infer_unit(spacing: float, whole: bool) -> str | None:
 def stamps_to_seconds(path: str, stamps: np.ndarray, where: np.ndarray, *, label: str = "line",
                       what: str = "timestamp", unit: str | None = None,
                       default: str = "s", keep_origin: bool = False) -> tuple[np.ndarray, str]:
-    """(seconds from the first sample, or from the file's zero with `keep_origin`; unit name). `where` holds each sample's line (or record) number
+    """(seconds from the first sample, or from the file's zero with `keep_origin`; unit name). `where` holds
+    each sample's line (or record) number
     for messages, `what` names the column; `unit` forces a unit (one of UNITS) instead of inferring it,
     `default` is the format's documented unit, used when a single sample gives no spacing. Checks that
     stamps are finite and strictly increasing; frames with nothing tracked count like any other (they keep

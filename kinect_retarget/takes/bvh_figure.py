@@ -4,7 +4,8 @@
 * up: the lab axis along which the head stays furthest above the feet over the take (not the rest offsets,
   which exporters such as Rokoko or Bandai-Namco write along each bone's own X);
 * unit: the one among metres, decimetres, CMU units, inches, centimetres and millimetres that makes the
-  figure's height (standing_height) closest to 1.7 m; a CMU-named skeleton keeps CMU units when they give a plausible height. A figure still outside
+  figure's height (standing_height) closest to 1.7 m; a CMU-named skeleton keeps CMU units when they give a
+  plausible height. A figure still outside
   1.0-2.3 m after the guess is read with a warning that names its height.
 """
 from __future__ import annotations
@@ -54,7 +55,7 @@ def standing_height(positions: np.ndarray, structure: StructureMapping, parents:
     pelvis, j, chain = structure.roles["HipCenter"].node, structure.top, 0.0
     while j != pelvis and parents[j] >= 0:
         chain, j = chain + bone(j, parents[j]), int(parents[j])
-    node = {r: m.node for r, m in structure.roles.items()}
+    node = {r: m.node for r, m in structure.roles.items() if m.node is not None}
     legs = [bone(node[f"Hip{s}"], node[f"Knee{s}"]) + bone(node[f"Knee{s}"], node[f"Ankle{s}"])
             for s in ("Left", "Right")]
     return max(posed, chain + float(np.mean(legs)))
@@ -68,7 +69,7 @@ def choose_unit(height_units: float, family: str | None, scale: float | None, pa
         return float(scale), f"{scale:g} m per unit (given)"
     if not height_units > 0:
         return 1.0, "metres (assumed: the figure has no height)"
-    known = bvh_names.FAMILY_UNITS.get(family)
+    known = bvh_names.FAMILY_UNITS.get(family) if family is not None else None
     if known and HEIGHT_RANGE[0] <= height_units * known <= HEIGHT_RANGE[1]:
         name = dict(UNITS).get(known, f"{known:g} m per unit")
         return known, f"{name} ({family} joint names)"

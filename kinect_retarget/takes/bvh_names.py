@@ -19,7 +19,7 @@ from __future__ import annotations
 #   Ankle = ankle; Foot = toe base.
 
 
-def _sided(table: dict[str, list[tuple[str, ...]]], left: str, right: str) -> dict:
+def _sided(table: dict[str, list[tuple[str, ...]]], left: tuple[str, ...], right: tuple[str, ...]) -> dict:
     """Expand '{s}' placeholders in a one-sided table into the Left and Right Kinect joints."""
     out: dict[str, list[tuple[str, ...]]] = {}
     for joint, alternatives in table.items():

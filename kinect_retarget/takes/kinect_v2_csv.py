@@ -1,7 +1,8 @@
 """Kinect v2 CSV as written by Microsoft's KinectReader (LabanotationSuite).
 
 One frame per line: `timestamp, (x, y, z, state) x 25`; timestamp in 100 ns sensor ticks (only differences
-matter; the unit is inferred from the spacing, _timebase, as other tools write ms or s), joints in Kinect v2 SDK order, camera space metres, state 0/1/2. Some files end lines with a comma.
+matter; the unit is inferred from the spacing, _timebase, as other tools write ms or s), joints in Kinect v2
+SDK order, camera space metres, state 0/1/2. Some files end lines with a comma.
 """
 from __future__ import annotations
 

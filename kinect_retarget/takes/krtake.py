@@ -66,7 +66,7 @@ class TakeWriter:
             self._fh.close()
             self._fh = None
 
-    def __enter__(self) -> "TakeWriter":
+    def __enter__(self) -> TakeWriter:
         return self
 
     def __exit__(self, *exc) -> None:
@@ -82,7 +82,7 @@ def write(path: str | os.PathLike, take: Take) -> None:
 def read(path: str | os.PathLike) -> Take:
     path = os.fspath(path)
     try:
-        with open(path, "r", encoding="utf-8") as fh:
+        with open(path, encoding="utf-8") as fh:
             first = fh.readline()
             body = fh.read()
     except UnicodeDecodeError as exc:

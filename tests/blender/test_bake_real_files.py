@@ -6,7 +6,6 @@ import json
 import subprocess
 import sys
 
-import pytest
 
 from kinect_retarget.takes import load_take
 from tests.takes import real_layout_fixtures as real

@@ -17,7 +17,7 @@ from kinect_retarget.sim.emulated_stream import Faults, VirtualClock
 from kinect_retarget.device.errors import DeviceGone, ProtocolError
 from kinect_retarget.device.motor import open_motor
 from kinect_retarget.device.protocol import TICKS_PER_FRAME
-from kinect_retarget.device.depth_stream import ERROR, STREAMING, UNPLUGGED, DepthStream
+from kinect_retarget.device.depth_stream import ERROR, UNPLUGGED, DepthStream
 
 
 def _watch(stream, until, seconds=20.0):

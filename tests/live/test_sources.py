@@ -120,6 +120,7 @@ def _send(port, packets):
             s.sendto(p, ("127.0.0.1", port))
 
 
+@pytest.mark.network   # UDP sockets on localhost
 def test_osc_receiver_end_to_end(rng):
     q = FrameQueue()
     src = OscReceiver(port=0)
@@ -141,6 +142,7 @@ def test_osc_receiver_end_to_end(rng):
     assert not src.alive
 
 
+@pytest.mark.network   # UDP sockets on localhost
 def test_osc_bad_packets_are_counted_and_shown_and_live_goes_on(rng):
     q = FrameQueue()
     src = OscReceiver(port=0)
@@ -160,6 +162,7 @@ def test_osc_bad_packets_are_counted_and_shown_and_live_goes_on(rng):
     assert not src.alive
 
 
+@pytest.mark.network   # UDP sockets on localhost
 def test_osc_port_in_use_is_a_clear_error():
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as busy:
         busy.bind(("127.0.0.1", 0))
@@ -169,6 +172,7 @@ def test_osc_port_in_use_is_a_clear_error():
     assert not src.alive
 
 
+@pytest.mark.network   # UDP sockets on localhost
 def test_osc_socket_error_on_the_thread_stops_with_error():
     q = FrameQueue()
     src = OscReceiver(port=0)
