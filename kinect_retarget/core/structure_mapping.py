@@ -161,7 +161,8 @@ class _Mapper:
         pairs = [(a, b) for i, a in enumerate(branches) for b in branches[i + 1:]
                  if max(size[a], size[b]) <= 1.25 * min(size[a], size[b])]
         if not pairs:
-            return tuple(sorted(branches, key=lambda b: -size[b])[:2])
+            first, second = sorted(branches, key=lambda b: -size[b])[:2]
+            return first, second
         return max(pairs, key=lambda p: min(size[p[0]], size[p[1]]))
 
     def _branches(self, j: int, frac: float) -> list[int]:
