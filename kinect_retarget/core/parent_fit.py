@@ -97,6 +97,7 @@ def learn(rig: TargetRig, mapped, user_basis: np.ndarray, constrained: dict[int,
     local = local_rotations(rig, basis)
     slot = {b: k for k, b in enumerate(mapped)}
     follows, fallback, errors = {}, [], {}
+    done = []  # bones placed so far: a target must be evaluated before the bone that follows it
     for b in order:
         p = int(rig.parents[b])
         own = mul(local[b], sample_basis[:, slot[b]]) if b in slot else np.broadcast_to(local[b], (len(evaluated), 4))
@@ -106,9 +107,14 @@ def learn(rig: TargetRig, mapped, user_basis: np.ndarray, constrained: dict[int,
             cands = {t: evaluated[:, t] for t in targets[b]}
             cands[-1] = np.broadcast_to(IDENTITY, ev.shape)
             follow, err = fit_follow(pre, ev, cands, n_fit)
+            if err > tolerance_deg:  # what it names does not explain it: try every mapped bone above it
+                more = {t: evaluated[:, t] for t in done if t in slot and t not in cands}
+                if more:
+                    follow, err = min((follow, err), fit_follow(pre, ev, more, n_fit), key=lambda r: r[1])
         else:
             follow, err = None, float(np.degrees(angle_between(pre, ev).max()))
         errors[b] = err
+        done.append(b)
         if err > tolerance_deg:
             fallback.append(b)
         elif follow is not None:

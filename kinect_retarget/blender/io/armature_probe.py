@@ -1,7 +1,7 @@
 """Learn how a rig's constraint-driven parents move (issue 15), evaluating the armature alone.
 
-Blender evaluates a linked copy of the armature object (same bones, its own pose) in a temporary scene that
-holds nothing else, so neither the user's meshes and modifiers nor their rig's pose are touched, and the
+Blender evaluates a copy of the armature object (same bones, its own pose) in a temporary scene that holds
+nothing else, so neither the user's meshes and modifiers nor their rig are evaluated or touched, and the
 cost does not grow with the character. The probe poses the copy at random a dozen times; core/parent_fit.py
 turns the evaluated rotations into relations numpy evaluates for every frame at once. Bones no relation
 explains are evaluated per frame on the copy (`solve_frames`), the only per-frame evaluations left.
@@ -46,13 +46,16 @@ def read_rotations(pose_bones, index, flat: np.ndarray, prop: str = "matrix") ->
 
 
 class ArmatureEvaluator:
-    """A temporary scene holding a linked copy of `obj` and nothing else; removed by close() (a context
-    manager). switches: pose bone -> value for its 'IK_FK' property on the copy (what the bake keys)."""
+    """A temporary scene holding a copy of `obj` (object and Armature data) and nothing else; removed by
+    close() (a context manager). switches: pose bone -> value for its 'IK_FK' property on the copy (what the bake keys)."""
 
     def __init__(self, obj: bpy.types.Object, bone_order, switches: dict[str, float] | None = None):
         self.source_name = obj.name
         self.scene = bpy.data.scenes.new(f"kinect_retarget_probe_{obj.name}")
-        self.copy = obj.copy()  # shares the Armature data: the same bones, a pose of its own
+        self.copy = obj.copy()  # a pose of its own
+        # the bones too: the Armature's own drivers (Rigify's B-Bone eases) read the object, and through
+        # them the user's rig would be evaluated (and written back) with the copy
+        self.copy.data = obj.data.copy()
         if self.copy.animation_data is not None:
             self.copy.animation_data.action = None  # keys would overwrite the poses set here; drivers stay
         self._retarget(obj)
@@ -76,16 +79,18 @@ class ArmatureEvaluator:
                 for t in getattr(con, "targets", ()):
                     if _uses(getattr(t, "target", None), obj):
                         t.target = self.copy
-        ad = self.copy.animation_data
-        for fc in ad.drivers if ad is not None else ():
-            for var in fc.driver.variables:
-                for t in var.targets:
-                    if _uses(t.id, obj):
-                        t.id = self.copy
+        for ad in (self.copy.animation_data, self.copy.data.animation_data):
+            for fc in ad.drivers if ad is not None else ():
+                for var in fc.driver.variables:
+                    for t in var.targets:
+                        if _uses(t.id, obj):
+                            t.id = self.copy
 
     def close(self) -> None:
         if self.copy is not None:
+            data = self.copy.data
             bpy.data.objects.remove(self.copy)
+            bpy.data.armatures.remove(data)
             bpy.data.scenes.remove(self.scene)
             self.copy = self.scene = None
 
