@@ -88,3 +88,26 @@ def test_core_imports_without_bpy():
     code = ("import sys, kinect_retarget, kinect_retarget.core.pipeline, kinect_retarget.takes;"
             "assert 'bpy' not in sys.modules and 'mathutils' not in sys.modules")
     subprocess.run([sys.executable, "-c", code], check=True, cwd=PACKAGE.parent)
+
+
+# Downward only (docs/architecture.md): which other top-level packages each bpy-free package may import.
+# (sources/ reaches sim/ only through the simulated-device entry point, checked above.)
+ALLOWED = {"core": set(), "takes": {"core"}, "device": {"core"}, "depth": {"core", "device"},
+           "lift": {"core", "takes"}, "autorig": {"core", "takes"},
+           "sources": {"core", "takes", "device", "depth", "assets", "sim"},
+           "live": {"core", "takes", "sources"},
+           "sim": {"core", "takes", "device", "depth", "lift", "autorig", "assets"}}
+
+
+def test_packages_import_only_the_layers_below_them():
+    offenders = []
+    for pkg, allowed in ALLOWED.items():
+        for path in (PACKAGE / pkg).rglob("*.py"):
+            for target in _all_targets(path):
+                parts = target.split(".")
+                if parts[0] != "kinect_retarget" or len(parts) < 2:
+                    continue
+                other = parts[1]
+                if other != pkg and (PACKAGE / other).is_dir() and other not in allowed:
+                    offenders.append(f"{path.relative_to(PACKAGE)} imports {target}")
+    assert not offenders, "imports against the layer order: " + "; ".join(sorted(set(offenders)))
