@@ -60,6 +60,7 @@ class FramePose:
     root_location: np.ndarray  # (3,)
     time: float
     desired: np.ndarray        # (M, 4) armature-space rotations, for rigs with constrained parents
+    positions: np.ndarray | None = None  # (J, 3) the frame's filtered joints (Kinect space), for the hands
 
 
 class RetargetPipeline:
@@ -174,4 +175,5 @@ class RetargetPipeline:
         quats, location, desired = self.retargeter.solve(p[-1:], self.root_reference, self.source_leg,
                                                          want_desired=True)
         quats[0, unseen] = (1.0, 0.0, 0.0, 0.0)  # joints never seen yet: their bones stay at rest
-        return FramePose(self.bone_names, quats[0], self.root_bone, location[0], float(times[-1]), desired[0])
+        return FramePose(self.bone_names, quats[0], self.root_bone, location[0], float(times[-1]), desired[0],
+                         p[-1])

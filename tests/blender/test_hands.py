@@ -79,3 +79,50 @@ def test_v1_takes_leave_the_fingers_alone(metarig):
     take = load_take("sample_takes/kinect_v1_cmu_131_03_hop.krtake").slice(slice(0, 30))
     res, msg = _bake(metarig, take)
     assert "hands:" not in msg and not any(b.startswith(("f_", "thumb")) for b in res.motion.bone_names)
+
+
+HAND_BONES = ("hand.L", "f_index.01.L", "f_middle.01.L", "thumb.01.R", "hand.R")
+
+
+def test_live_hands_equal_the_bake_of_the_recording(metarig, tmp_path):
+    """A live v2 source rolls the hands and bends the fingers as the bake of its recording keys them."""
+    import time
+    import bpy
+    import kinect_retarget
+    from kinect_retarget.blender.live import live_runtime as live
+    from kinect_retarget.sources import TakePlayback
+    from kinect_retarget.takes import krtake
+    take = load_take("sample_takes/kinect_v2_ges03_drawlines.krtake").slice(slice(0, 45))
+    kinect_retarget.register()
+    try:
+        scene = bpy.context.scene
+        scene.render.fps = 30
+        s = scene.kinect_retarget
+        s.initialised, s.armature, s.record_dir, s.play_on_record, s.filter = True, metarig, str(tmp_path), False, \
+            "none"
+        rest = np.array([metarig.pose.bones[b].rotation_quaternion[:] for b in HAND_BONES])
+        seen = []
+        c = live.start_live(bpy.context, source=TakePlayback(take, speed=2.0), use_timer=False)
+        assert len(c.hands) == 2
+        apply = c.session.apply
+        c.session.apply = lambda pose: (apply(pose), seen.append(
+            (pose.time, np.array([metarig.pose.bones[b].rotation_quaternion[:] for b in HAND_BONES]))))
+        c.start_recording(bpy.context)
+        rec_path, start = c.recording["path"], c.recording["frame_start"]
+        end = time.perf_counter() + 60
+        while live.pump_live() and time.perf_counter() < end:
+            time.sleep(0.003)
+        assert live.controller() is None and len(seen) >= 5
+        assert np.degrees(angle_between(seen[-1][1], rest)).max() > 1.0  # live moved the hands and fingers
+        rec = krtake.read(rec_path)
+        for t, held in seen[:: max(1, len(seen) // 6)]:
+            i = int(np.argmin(np.abs(rec.times - t)))
+            frame = start + round(rec.times[i] * 30)
+            if i and frame == start + round(rec.times[i - 1] * 30):
+                continue  # another sample owns this frame's key
+            scene.frame_set(frame)
+            baked = np.array([metarig.pose.bones[b].rotation_quaternion[:] for b in HAND_BONES])
+            assert np.degrees(angle_between(baked, held)).max() < 1e-3
+    finally:
+        live.stop_live(bake=False)
+        kinect_retarget.unregister()

@@ -3,7 +3,7 @@ rest pose, and the bake step that rolls the hand from Kinect v2's thumb, bends t
 and curls them from the hand states (core/hand_pose.py). The rig itself is never changed."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import bpy
 import numpy as np
@@ -63,36 +63,69 @@ def hands_on_rig(obj: bpy.types.Object, mapped) -> list[HandRig]:
     return out
 
 
+def hand_frames(rig: HandRig, hand_quats: np.ndarray, desired: np.ndarray, hand: np.ndarray, thumb: np.ndarray,
+                tip: np.ndarray, curls: np.ndarray | None) -> tuple[np.ndarray, list[tuple[str, np.ndarray]]]:
+    """One hand over F frames (bake: a take, live: one frame): the hand bone's pose quaternions (F, 4) rolled
+    to the thumb, and (finger bone, (F, 4)) bent toward the hand tip and curled by `curls` (F, 5) or not.
+    desired (F, 3, 3) the hand's armature-space rotation; hand, thumb, tip (F, 3) joints in armature space."""
+    roll = hand_roll(desired, rig.thumb_local, thumb - hand)
+    c, s = np.cos(roll), np.sin(roll)
+    ry = np.zeros((len(roll), 3, 3))
+    ry[:, 0, 0], ry[:, 0, 2], ry[:, 1, 1], ry[:, 2, 0], ry[:, 2, 2] = c, s, 1.0, -s, c
+    bend = fingers_bend(desired @ ry, rig.curl_local, tip - hand)
+    curls = np.zeros((len(roll), len(FINGERS))) if curls is None else curls
+    fingers = []
+    for f, finger in enumerate(FINGERS):
+        for j, bone in enumerate(rig.chains.get(finger, ())):
+            angle = np.radians(CURL_DEG) * curls[:, f] + (bend if j == 0 and finger != "thumb" else 0.0)
+            fingers.append((bone, finger_quats(rig.axes[bone], angle)))
+    return twist_quats(hand_quats, roll), fingers
+
+
+def _has_hand_joints(rig: HandRig, index: dict) -> bool:
+    return {f"Hand{rig.side}", f"HandTip{rig.side}", f"Thumb{rig.side}"} <= set(index)
+
+
 def apply_hands(motion, rigs: list[HandRig], take, joints: tuple[str, ...], mirror: bool) -> list[str]:
     """Roll each hand from the thumb, bend and curl its fingers; the finger bones join the motion's keyed
     bones. joints: the take's joint names. Returns the finger bones added."""
     p = kinect_to_blender(motion.extras["positions"])  # armature space (the retarget's frame)
     index = {n: i for i, n in enumerate(joints)}
-    times = take.times[motion.samples]
     added, quats = [], []
     for rig in rigs:
-        if rig.hand not in motion.bone_names or not {f"HandTip{rig.side}", f"Thumb{rig.side}"} <= set(index):
+        if rig.hand not in motion.bone_names or not _has_hand_joints(rig, index):
             continue
         k = motion.bone_names.index(rig.hand)
-        hand_p = p[:, index[f"Hand{rig.side}"]]
-        desired = to_matrix(motion.extras["desired"][:, k])
-        roll = hand_roll(desired, rig.thumb_local, p[:, index[f"Thumb{rig.side}"]] - hand_p)
-        motion.quats[:, k] = twist_quats(motion.quats[:, k], roll)
-        c, s = np.cos(roll), np.sin(roll)
-        ry = np.zeros((len(roll), 3, 3))
-        ry[:, 0, 0], ry[:, 0, 2], ry[:, 1, 1], ry[:, 2, 0], ry[:, 2, 2] = c, s, 1.0, -s, c
-        rolled = desired @ ry
-        bend = fingers_bend(rolled, rig.curl_local, p[:, index[f"HandTip{rig.side}"]] - hand_p)
-        curls = np.zeros((len(times), len(FINGERS)))
+        curls = None
         if take.hand_states is not None:
             column = (0 if rig.side == "Left" else 1) ^ int(mirror)  # mirrored takes swap the hands
             curls = finger_curls(take.hand_states[:, column], take.times)[motion.samples]
-        for f, finger in enumerate(FINGERS):
-            for j, bone in enumerate(rig.chains.get(finger, ())):
-                angle = np.radians(CURL_DEG) * curls[:, f] + (bend if j == 0 and finger != "thumb" else 0.0)
-                added.append(bone)
-                quats.append(finger_quats(rig.axes[bone], angle))
+        joint = [p[:, index[f"{j}{rig.side}"]] for j in ("Hand", "Thumb", "HandTip")]
+        motion.quats[:, k], fingers = hand_frames(rig, motion.quats[:, k], to_matrix(motion.extras["desired"][:, k]),
+                                                  *joint, curls)
+        added += [b for b, _ in fingers]
+        quats += [q for _, q in fingers]
     if added:
         motion.bone_names = tuple(motion.bone_names) + tuple(added)
         motion.quats = make_continuous(np.concatenate([motion.quats, np.stack(quats, axis=1)], axis=1), axis=0)
     return added
+
+
+def pose_with_hands(pose, rigs: list[HandRig], joints: tuple[str, ...]):
+    """A live FramePose with the hands rolled and the fingers bent (live sources give no hand states), as
+    the bake of its recording keys them."""
+    if not rigs or pose.positions is None:
+        return pose
+    p = kinect_to_blender(pose.positions)
+    index = {n: i for i, n in enumerate(joints)}
+    names, quats = list(pose.bone_names), pose.quats.copy()
+    for rig in rigs:
+        if rig.hand not in names or not _has_hand_joints(rig, index):
+            continue
+        k = names.index(rig.hand)
+        joint = [p[None, index[f"{j}{rig.side}"]] for j in ("Hand", "Thumb", "HandTip")]
+        hand, fingers = hand_frames(rig, quats[k][None], to_matrix(pose.desired[k])[None], *joint, None)
+        quats[k] = hand[0]
+        names += [b for b, _ in fingers]
+        quats = np.concatenate([quats, np.stack([q[0] for _, q in fingers])])
+    return replace(pose, bone_names=tuple(names), quats=quats)

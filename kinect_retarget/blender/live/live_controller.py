@@ -24,6 +24,7 @@ from ...sources import SourceError
 from ...takes import load_take
 from ..bake_take import bake_take, make_pipeline
 from ..io.armature_probe import ArmatureEvaluator, constrained_summary, probe_parents, read_rotations, solve_frames
+from ..io.finger_rig import hands_on_rig, pose_with_hands
 from ..io.pose_apply import apply_frame_pose
 from ..io.rig_reader import fk_switch_bones, has_constrained_ancestry
 from ..ui.bake_settings import recording_bake_options
@@ -42,6 +43,7 @@ class LiveSettings:
     exact_constrained: bool = False     # fallback bones of constrained rigs evaluated on an armature copy
     bake_on_stop: bool | None = None    # None: the scene's Bake on Stop toggle at the moment live stops
     lost_tracking_timeout: float = 2.0
+    hands: str = "auto"                 # Kinect v2 hands on rigs with finger bones (auto: v2 sources)
 
 
 def _apply_saved_calibration(obj, source, pipeline) -> None:
@@ -80,6 +82,10 @@ class LiveController:
         self.evaluator = None   # the armature copy for Exact on Constrained Rigs, only with fallback bones
         self.update_after_apply = False
         self.exact = False
+        joints = source.skeleton.joints
+        wanted = settings.hands == "on" or (settings.hands == "auto" and "HandTipLeft" in joints)
+        self.hands = hands_on_rig(obj, pipeline.retargeter.mapped) if wanted else []
+        self._joints = joints
 
     def start(self) -> None:
         """Save the rig's state, switch Rigify limbs to FK, learn its constrained parents, start the source; on
@@ -135,7 +141,7 @@ class LiveController:
                                           pose.root_location[None], [scene.frame_current] if scene else None)[0]
             else:  # fallback bones (if any) as the viewport last evaluated them: one frame late
                 pose.quats = model.solve(pose.desired[None], self._evaluated(obj) if model.fallback else None)[0]
-        apply_frame_pose(obj, pose)
+        apply_frame_pose(obj, pose_with_hands(pose, self.hands, self._joints))
         if self.update_after_apply:
             bpy.context.view_layer.update()  # no viewport redraw to evaluate the fallback bones
 

@@ -91,7 +91,7 @@ def settings_from_scene(context) -> tuple[LiveSettings, dict | None]:
     prefs = get_preferences(context)
     settings = LiveSettings(preset=s.preset,
                             retarget=RetargetSettings(filter=s.filter, root_mode=s.root, mirror=s.mirror),
-                            exact_constrained=bool(s.exact_constrained), bake_on_stop=None,
+                            exact_constrained=bool(s.exact_constrained), bake_on_stop=None, hands=s.hands,
                             lost_tracking_timeout=prefs.lost_tracking_timeout if prefs is not None else 2.0)
     return settings, table_overrides(s)
 
