@@ -1,6 +1,7 @@
 """Bake a take onto an armature: the one function behind the operator, the CLI and the demo."""
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass, replace
 from typing import Callable
@@ -166,7 +167,10 @@ def _reading(meta: dict) -> str:
     """What was guessed while reading a BVH file, for the bake report."""
     if "bvh_unit" not in meta:
         return ""
-    return (f"; BVH read in {meta['bvh_unit']}, {meta['bvh_up_axis']} up, figure "
+    up, axis = meta.get("bvh_up"), meta["bvh_up_axis"]
+    tilt = math.degrees(math.acos(min(1.0, abs(up["XYZ".index(axis[1])])))) if up else 0.0
+    tilted = f" (the floor tilted {tilt:.1f} degrees from it)" if tilt > 0.05 else ""
+    return (f"; BVH read in {meta['bvh_unit']}, {axis} up{tilted}, figure "
             f"{meta['bvh_standing_height_m']:.2f} m tall, {meta['bvh_position_channels']}")
 
 

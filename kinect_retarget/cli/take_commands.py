@@ -69,7 +69,7 @@ def bake_options_from_args(args) -> BakeOptions:
 
 
 BVH_FIELDS = {"bvh_unit": "unit", "bvh_standing_height_m": "standing_height_m", "bvh_up_axis": "up_axis",
-              "bvh_position_channels": "position_channels", "bvh_mapping_notes": "mapping_notes",
+              "bvh_up": "up", "bvh_position_channels": "position_channels", "bvh_mapping_notes": "mapping_notes",
               "bvh_mapping": "mapping"}
 
 

@@ -12,8 +12,9 @@ API
 * ``parents``: (N,) parent index of each node, -1 for a root. Any order (a parent may follow its child).
 * ``rest``: (N, 3) node positions in one pose (the rest pose); any units, any up axis.
 * ``frames``: optional (F, N, 3) node positions over a take. With them, up, facing and left/right come from
-  the motion (head above pelvis above feet, toes and knees pointing forward) and twist nodes are found as
-  the nodes that never bend; without them the rest pose is the only frame.
+  the motion (the floor under the feet and the head above them, core/floor_plane.py; toes and knees pointing
+  forward) and twist nodes are found as the nodes that never bend; without them the rest pose is the only
+  frame.
 * ``end_site``: optional (N,) bool, True for nodes that only mark where a chain ends (BVH End Site).
 
 A node is a point: for BVH a joint or end site; for a Blender armature pass every bone's head as a node
@@ -35,6 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .floor_plane import estimate_up
 from .skeletons import KINECT_V1
 from .structure_names import kinect_names, name_side
 
@@ -63,8 +65,9 @@ class RoleMatch:
 @dataclass
 class StructureMapping:
     roles: dict[str, RoleMatch]
-    up_axis: int                 # 0, 1, 2: the lab axis pointing up
+    up_axis: int                 # 0, 1, 2: the lab axis nearest to up
     up_sign: float
+    up_vector: np.ndarray        # (3,) unit: up (the floor's normal when the capture volume is tilted)
     forward: np.ndarray          # (3,) unit, horizontal: where the figure faces (median over the take)
     top: int                     # the node at the top of the head
     feet: tuple[int, ...]        # nodes of both legs from the ankle down (the lowest points of a standing figure)
@@ -72,7 +75,7 @@ class StructureMapping:
 
     @property
     def up(self) -> np.ndarray:
-        return np.eye(3)[self.up_axis] * self.up_sign
+        return self.up_vector
 
     def indices(self) -> dict[str, tuple[int, ...]]:
         """{role: nodes to average} (empty tuple: none, the caller extrapolates)."""
@@ -302,8 +305,9 @@ class _Mapper:
             head.extend(self.kids[j])
         top = max(head, key=lambda j: self._dist(chest, j))
         head_chain = self._joints(self._path_up(top, chest))
-        up_axis, up_sign = self._up(top, leg_a, leg_b)
-        up = np.eye(3)[up_axis] * up_sign
+        est = estimate_up(self.pos, top, (leg_a["feet"], leg_b["feet"]))  # core/floor_plane.py
+        up = est.up
+        self.notes.append(f"up: {est.how}")
         forward, a_is_left = self._facing(up, leg_a, leg_b, legs)
         if not a_is_left:
             leg_a, leg_b = leg_b, leg_a
@@ -313,17 +317,8 @@ class _Mapper:
             arm_a, arm_b = arm_b, arm_a
         roles = self._roles(pelvis, chest, spine, head_chain, top, arm_a, arm_b, leg_a, leg_b)
         roles = kinect_names(self.names, self.ends, roles, self.notes)
-        return StructureMapping(roles, up_axis, up_sign, forward, top, leg_a["feet"] + leg_b["feet"], self.notes)
-
-    def _up(self, top: int, leg_a: dict, leg_b: dict) -> tuple[int, float]:
-        """Head above the feet over the take: the lab axis along which they are furthest apart."""
-        d = self.pos[:, top] - (self.pos[:, leg_a["Ankle"]] + self.pos[:, leg_b["Ankle"]]) / 2
-        mean = d.mean(axis=0)
-        axis = int(np.argmax(np.abs(mean)))
-        tilt = np.degrees(np.arccos(min(1.0, abs(mean[axis]) / max(np.linalg.norm(mean), 1e-12))))
-        if tilt > 30:
-            self.notes.append(f"head-over-feet direction is {tilt:.0f} degrees off the nearest axis")
-        return axis, float(np.sign(mean[axis]) or 1.0)
+        return StructureMapping(roles, est.axis, est.sign, up, forward, top, leg_a["feet"] + leg_b["feet"],
+                                self.notes)
 
     def _facing(self, up: np.ndarray, leg_a: dict, leg_b: dict, legs: list[int]) -> tuple[np.ndarray, bool]:
         """Forward (horizontal unit) and whether leg A is the left one: from the toes, else the knees, else names."""

@@ -154,7 +154,7 @@ def rotations_from_cmu(mh: MakeHuman, motion, frame: int) -> np.ndarray:
     names = motion.skeleton.names
     spell = 0 if "LeftUpLeg" in names else 1
     rest = motion.rest_positions
-    up = np.eye(3)[motion.up_axis] * motion.up_sign
+    up = motion.up
     left = rest[names.index(("LeftUpLeg", "LeftHip")[spell])] - rest[names.index(("RightUpLeg", "RightHip")[spell])]
     left -= up * (left @ up)
     left /= np.linalg.norm(left)

@@ -65,8 +65,9 @@ class BvhMotion:
     rest_positions: np.ndarray   # (N, 3) positions with every channel zero (the hierarchy's rest pose)
     family: str | None = None    # naming family from bvh_names (informational), None if not recognised
     units_to_metres: float = 1.0
-    up_axis: int = 1             # 0, 1 or 2: the lab axis pointing up
+    up_axis: int = 1             # 0, 1 or 2: the lab axis nearest to up
     up_sign: float = 1.0
+    up_vector: np.ndarray | None = None  # up itself when the capture volume is tilted (floor_plane.py)
     notes: dict = field(default_factory=dict)
     # {kinect joint: BVH joint indices averaged} (empty tuple: extrapolated); None when not a humanoid
     mapping: dict | None = None
@@ -80,6 +81,10 @@ class BvhMotion:
     @property
     def frame_count(self) -> int:
         return int(self.values.shape[0])
+
+    @property
+    def up(self) -> np.ndarray:
+        return np.eye(3)[self.up_axis] * self.up_sign if self.up_vector is None else self.up_vector
 
     @property
     def positions_m(self) -> np.ndarray:
@@ -107,6 +112,7 @@ def read_bvh_skeleton(path: str | os.PathLike, scale: float | None = None) -> Bv
     else:
         motion.mapping = motion.structure.indices()
         motion.up_axis, motion.up_sign = motion.structure.up_axis, motion.structure.up_sign
+        motion.up_vector = motion.structure.up
         motion.height_units = standing_height(positions, motion.structure, sk.parents)
     motion.units_to_metres, motion.notes["units"] = choose_unit(motion.height_units, motion.family, scale, path)
     warning = height_warning(motion.height_units * motion.units_to_metres, motion.notes["units"])
@@ -133,6 +139,7 @@ def describe(motion: BvhMotion) -> dict:
     return {"bvh_unit": motion.notes["units"], "bvh_units_to_metres": motion.units_to_metres,
             "bvh_standing_height_m": round(motion.height_units * motion.units_to_metres, 3),
             "bvh_up_axis": ("+" if motion.up_sign > 0 else "-") + "XYZ"[motion.up_axis],
+            "bvh_up": [round(float(v), 4) for v in motion.up],
             "bvh_position_channels": POSITION_MODES[motion.position_mode],
             "bvh_mapping": s.describe(motion.skeleton.names), "bvh_mapping_notes": list(s.notes)}
 
@@ -170,8 +177,7 @@ def virtual_kinect(motion: BvhMotion, distance: float = DEFAULT_CAMERA_DISTANCE,
     """
     if joints is None:
         joints = kinect_joints_lab(motion)
-    up = np.zeros(3)
-    up[motion.up_axis] = motion.up_sign
+    up = motion.up
     floor = float(np.nanmin(motion.positions_m @ up))  # NaN channels (dropped later) must not decide it
     k = KINECT_V1.index
     hips = joints[:, [k("HipLeft"), k("HipRight"), k("HipCenter")]]

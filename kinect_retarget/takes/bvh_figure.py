@@ -1,8 +1,9 @@
 """What a BVH skeleton is: its Kinect v1 joints (by structure), which way is up, and its unit.
 
 * joints: core/structure_mapping.py on the posed joints over the take (names only break ties);
-* up: the lab axis along which the head stays furthest above the feet over the take (not the rest offsets,
-  which exporters such as Rokoko or Bandai-Namco write along each bone's own X);
+* up: the floor under the feet's lowest points when they spread over it, else the lab axis along which the
+  head stays furthest above the feet over the take (core/floor_plane.py; never the rest offsets, which
+  exporters such as Rokoko or Bandai-Namco write along each bone's own X);
 * unit: the one among metres, decimetres, CMU units, inches, centimetres and millimetres that makes the
   figure's height (standing_height) closest to 1.7 m; a CMU-named skeleton keeps CMU units when they give a
   plausible height. A figure still outside

@@ -40,10 +40,37 @@ def scaled(fig: Figure, s: float) -> Figure:
     return replace(fig, offsets=fig.offsets * s, root_pos=fig.root_pos * s)
 
 
-def z_up(fig: Figure) -> Figure:
-    """The same take in a Z-up world: every offset and rotation expressed in rotated axes."""
-    a = np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]])  # +90 degrees about X: Y -> Z
+def about_x(degrees: float) -> np.ndarray:
+    c, s = np.cos(np.radians(degrees)), np.sin(np.radians(degrees))
+    return np.array([[1.0, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def rotated(fig: Figure, a: np.ndarray) -> Figure:
+    """The same take in rotated lab axes (rotation matrix `a`): every offset and rotation expressed in them."""
     return replace(fig, offsets=fig.offsets @ a.T, local=a @ fig.local @ a.T, root_pos=fig.root_pos @ a.T)
+
+
+def z_up(fig: Figure) -> Figure:
+    """The same take in a Z-up world (+90 degrees about X: Y -> Z)."""
+    return rotated(fig, about_x(90.0))
+
+
+def lying_down(fig: Figure, positions: np.ndarray, ankles: list[int], frames: slice) -> Figure:
+    """The performer (Y up) lies down on their back over `frames` and holds still: the pose of the first of
+    those frames turned -90 degrees about X around the hips, lowered until the lower ankle is as high above
+    the floor as when standing (heel on the floor). `positions`: (F, N, 3) the source's joints (forward
+    kinematics), for the heights."""
+    w = about_x(-90.0)
+    root = int(np.flatnonzero(fig.parents < 0)[0])
+    first = frames.start
+    floor = np.median(positions[:, ankles, 1].min(axis=1))  # the lower ankle's height while standing
+    pivot = positions[first, root]
+    drop = ((positions[first, ankles] - pivot) @ w.T + pivot)[:, 1].min() - floor
+    local, root_pos = fig.local.copy(), fig.root_pos.copy()
+    local[frames] = fig.local[first]
+    local[frames, root] = w @ fig.local[first, root]
+    root_pos[frames] = pivot - np.array([0.0, drop, 0.0])
+    return replace(fig, local=local, root_pos=root_pos)
 
 
 def _frame_with_x(d: np.ndarray) -> np.ndarray:
