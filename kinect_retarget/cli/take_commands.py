@@ -106,7 +106,9 @@ def run_info(args) -> int:
                 for joint, how in v.items():
                     print(f"  {joint:<{width - 2}}  {how}")
             else:
-                print(f"{k:<{width}}  {'; '.join(v) if isinstance(v, list) else v}")
+                if isinstance(v, list):  # notes joined by "; ", a vector (the BVH up) by spaces
+                    v = ("; " if all(isinstance(x, str) for x in v) else " ").join(map(str, v))
+                print(f"{k:<{width}}  {v}")
     return 0
 
 
