@@ -6,14 +6,17 @@ Two estimates (issue 21), used by core/structure_mapping.py:
   figure that stands for most of the take, wrong for one that lies down or bends over for most of it.
 * **floor**: gravity from the feet's lowest points. Every foot node (ankle, toe, end site) in every frame is a
   candidate floor contact; a plane is fitted to the lower envelope of each node's points over the take, one
-  height per node, one shared slope (points above it, a lifted foot or a jump, are trimmed away). Its normal
-  is up, whatever the body does above the feet: a performer lying on the floor still has their heels on it.
+  height per node (the same for left and right), one shared slope; points above it (a lifted foot, a jump)
+  are trimmed away and each place a node touches counts once, however long it rests there. Its normal is up,
+  whatever the body does above the feet: a performer lying on the floor still has their heels on it.
 
-How they combine: the floor wins when it is well determined: enough contacts, spread over the floor in both
-directions (a performer standing in one place gives a patch too small to tell a tilt from foot roll). It is
-oriented so the body is above it. Within LEVEL_DEG of a lab axis it is snapped to that axis (capture volumes
-are level; the rest is foot-roll noise), beyond that the capture volume is taken as tilted and the floor's own
-normal is up. Without a usable floor, up is the lab axis nearest the head-over-feet direction.
+How they combine: the floor wins when it is well determined: at least MIN_CONTACTS frames with a foot on it,
+spread over MIN_SPREAD of the stature in both directions (a performer standing in one place gives a patch too
+small to tell a tilt from foot roll), and a figure that stands up straight on it (within STANDS_DEG) in some
+frames (a slanted plane through a dancer's feet on one spot is not believed). It is oriented so the body is
+above it. Within LEVEL_DEG of a lab axis it is snapped to that axis (capture volumes are level; real level
+takes measure 0-3 degrees of foot-roll noise), beyond that the capture volume is taken as tilted and the
+floor's own normal is up. Without a usable floor, up is the lab axis nearest the head-over-feet direction.
 """
 from __future__ import annotations
 
@@ -21,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-LEVEL_DEG = 2.0       # a floor normal this close to a lab axis is that axis
+LEVEL_DEG = 5.0       # a floor normal this close to a lab axis is that axis (level real takes measure 0-3)
 CONTACT_TOL = 0.02    # a contact more than this fraction of the stature above the floor is in the air
 MIN_SPREAD = 0.12     # contacts must spread (std along their narrower direction) this fraction of the stature,
 CELL = 0.05          # ... measured over the distinct cells of this fraction of the stature the feet touch

@@ -1,4 +1,4 @@
-"""Real BVH files from nine sources (tests/data/bvh/README.md): each maps by structure onto the Kinect
+"""Real BVH files from ten sources (tests/data/bvh/README.md): each maps by structure onto the Kinect
 joints, with the right unit and up axis, and bakes an upright, human-sized figure that follows its joints."""
 from __future__ import annotations
 
@@ -32,6 +32,9 @@ EXPECTED = {
     "univrm_sample.bvh": ("centimetres", "+Y", {"ElbowRight": "RightForeArm", "HandLeft": "LeftHand_end"}),
     "blender_export_kinect_rig.bvh": ("metres", "+Z", {"ShoulderLeft": "ElbowLeft", "WristRight": "HandRight",
                                                        "HipLeft": "KneeLeft", "HandLeft": "HandLeft_end"}),
+    "optitrack_arena_louise.bvh": ("centimetres", "+Y", {"ShoulderLeft": "LeftShoulder", "ElbowLeft": "LeftElbow",
+                                                         "WristLeft": "LeftWrist", "HandLeft": "LeftWrist_end",
+                                                         "KneeRight": "RightKnee", "FootRight": "RightAnkle_end"}),
     "kinect_openni_nite.bvh": ("centimetres", "+Y", {**{j: j for j in KINECT_V1.joints if j[:-4] in (
         "Shoulder", "Elbow", "Wrist", "Knee", "Ankle") or j.startswith("Hip") and j != "HipCenter"},
         "Head": "Head", "ShoulderCenter": "ShoulderCenter", "HandLeft": "WristLeft_end"}),
