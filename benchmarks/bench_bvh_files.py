@@ -1,5 +1,6 @@
 """Every BVH file in the repository (and the workshop's shared data when it is there): the Kinect joints the
-structural mapper found, the unit, the up axis, the position-channel reading, and the baked figure.
+structural mapper found, the unit, the up axis (and what gave it: the floor under the feet, with its angle to
+the axis, or the head above the feet), the position-channel reading, and the baked figure.
 
     .venv/bin/python benchmarks/bench_bvh_files.py [--mapping]
 
@@ -12,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import gzip
+import re
 import tempfile
 import time
 from pathlib import Path
@@ -47,8 +49,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--mapping", action="store_true", help="print every joint's mapping, not just a summary")
     args = ap.parse_args()
-    print(f"{'file':58s} {'frames':>6s} {'unit':12s} {'up':3s} {'pos.ch':8s} {'stand m':>7s} {'baked m':>7s} "
-          f"{'upright':7s} {'read s':>6s}  mapping (selected joints)")
+    print(f"{'file':58s} {'frames':>6s} {'unit':12s} {'up':3s} {'up from':12s} {'pos.ch':8s} {'stand m':>7s} "
+          f"{'baked m':>7s} {'upright':7s} {'read s':>6s}  mapping (selected joints)")
     with tempfile.TemporaryDirectory() as tmp:
         for path in files():
             rel = path.relative_to(_common.REPO) if _common.REPO in path.parents else path
@@ -65,9 +67,12 @@ def main() -> None:
             reading = meta["bvh_position_channels"]
             mode = "full" if "full local" in reading else ("delta" if "added" in reading else "root")
             mapping = meta["bvh_mapping"]
+            note = next((n for n in meta["bvh_mapping_notes"] if n.startswith("up: ")), "")
+            tilt = re.search(r"(?:level \(|tilted )([0-9.]+) degrees", note)
+            source = f"floor {tilt.group(1)}deg" if note.startswith("up: floor") and tilt else "head"
             summary = ", ".join(f"{SHORT[j]}={mapping[j].split(' (')[0]}" for j in SHORT)
             print(f"{rel!s:58s} {take.frame_count:6d} {meta['bvh_unit'].split(' (')[0]:12s} "
-                  f"{meta['bvh_up_axis']:3s} {mode:8s} {meta['bvh_standing_height_m']:7.3f} "
+                  f"{meta['bvh_up_axis']:3s} {source:12s} {mode:8s} {meta['bvh_standing_height_m']:7.3f} "
                   f"{fig['head_to_foot_m']:7.3f} {fig['upright']!s:7s} {dt:6.3f}  {summary}")
             for w in meta.get("warnings", ()):
                 print(f"{'':58s} warning: {w}")
