@@ -1,5 +1,7 @@
 """Auto-rig (paper 003) on MakeHuman's base mesh: joint accuracy at rest and posed, symmetry, inside-ness,
-time, and the paper's table 3 (skeleton points per level against a Reeb-graph baseline). Prints figures.
+time, and the paper's table 3 (skeleton points per level against a Reeb-graph baseline); the two joint rules
+(our geodesic fractions, the default, against the paper's skeleton points at K = 2..7 and both eq. 6
+normalizations) on the same meshes. Prints figures.
 
     .venv/bin/python benchmarks/bench_autorig.py [--frames N] [--random N] [--seed S]
 
@@ -28,7 +30,8 @@ from kinect_retarget.sim.autorig_scoring import (joint_errors, load_makehuman, p
 from kinect_retarget.autorig.mesh_geodesic import dijkstra  # noqa: E402
 from kinect_retarget.autorig.graph import mesh_graph  # noqa: E402
 from kinect_retarget.autorig.inside import inside_mesh  # noqa: E402
-from kinect_retarget.autorig.levels import reeb_baseline  # noqa: E402
+from kinect_retarget.autorig.levels import paper_skeleton, reeb_baseline  # noqa: E402
+from kinect_retarget.autorig.joints_paper import paper_joints  # noqa: E402
 from kinect_retarget.autorig.mesh import Mesh, subdivide  # noqa: E402
 from kinect_retarget.core.skeletons import KINECT_V1  # noqa: E402
 from kinect_retarget.takes.bvh import read_bvh_skeleton  # noqa: E402
@@ -78,6 +81,7 @@ def main() -> None:
         for fr in sorted({int(f) for f in even} | {int(f) for f in rand}):
             poses.append((f"CMU {name} frame {fr}", rotations_from_cmu(mh, motion, fr)))
     failures = 0
+    rules = [("rest (A-pose)", mh.body, rest, reference_joints(mh))]
     inside_all = [inside_mesh(rest.joints, mh.body.vertices, mh.body.faces)]
     groups = {"rest (A-pose)": [err]}
     outside = []
@@ -90,6 +94,7 @@ def main() -> None:
             print(f"{label:28s} FAILED: {exc}")
             continue
         e = joint_errors(rig.joints, reference_joints(mh, rot), h)
+        rules.append((label, posed, rig, reference_joints(mh, rot)))
         all_err.append(e)
         ins = inside_mesh(rig.joints, posed.vertices, posed.faces)
         inside_all.append(ins)
@@ -111,6 +116,8 @@ def main() -> None:
     ins = np.array(inside_all)
     print(f"joints inside the mesh (winding number > 0.5): {ins.mean():.1%} "
           f"({int((~ins).sum())} outside over {len(ins)} meshes{': ' if outside else ''}{'; '.join(outside)})")
+
+    compare_joint_rules(rules, h)
 
     print("\n== symmetry (rest mesh is symmetric about x = 0)")
     print(f"largest left/right mismatch: {symmetry_error(rest.joints, np.array([1.0, 0, 0]), np.zeros(3), h):.3f} % "
@@ -147,9 +154,36 @@ def main() -> None:
         rig = autorig(mesh)
         gph = mesh_graph(mesh.vertices[rig.body], rig_faces(mesh, rig))
         reeb = reeb_baseline(mesh.vertices[rig.body], gph, rig.features.distances[0], 4)
-        for method, sk in (("paper (segments x levels)", rig.paper), ("Reeb graph of head geodesic", reeb)):
+        glob = paper_skeleton(mesh.vertices[rig.body], gph, rig.features.distances, 4, "global")
+        for method, sk in (("paper (segments x levels)", rig.paper), ("paper, eq. 6 over all vertices", glob),
+                           ("Reeb graph of head geodesic", reeb)):
             c = sk.count_per_level(4)
             print(f"{label:24s} {method:28s}       {c[0]:2d} {c[1]:2d} {c[2]:2d} {c[3]:2d}   {c.sum():3d}")
+
+
+def compare_joint_rules(rigged, h: float) -> None:
+    """The joint rules on the same meshes: the default (fractions) against the paper's skeleton points
+    (joints_paper.py) for several K and both normalizations; one feature-point search per mesh."""
+    print("\n== joint rules on the same meshes (% of height; inside = joints within the mesh)")
+    configs = [("fractions (default)", None, None)] + [(f"paper K={k} segment", k, "segment") for k in (2, 3, 4, 5, 7)] \
+        + [(f"paper K={k} global", k, "global") for k in (2, 4, 7)]
+    print(f"{'rule':24s} {'rest mean/max':>14s} {'posed mean':>10s} {'held-out mean':>13s} {'all max':>8s} "
+          f"{'within 3 %':>10s} {'inside':>7s}")
+    for title, k, norm in configs:
+        errs, inside, held = [], [], []
+        for label, mesh, rig, ref in rigged:
+            if k is None:
+                joints = rig.joints
+            else:
+                v = rig.body_points
+                sk = paper_skeleton(v, mesh_graph(v, rig_faces(mesh, rig)), rig.features.distances, k, norm)
+                joints = paper_joints(v, rig.features, sk, rig.height)
+            errs.append(joint_errors(joints, ref, h))
+            inside.append(inside_mesh(joints, mesh.vertices, mesh.faces))
+            held += [errs[-1]] if any(c in label for c in HELD_OUT) else []
+        e = np.array(errs)
+        print(f"{title:24s} {e[0].mean():6.2f} / {e[0].max():5.2f} {e[1:].mean():10.2f} {np.mean(held):13.2f} "
+              f"{e.max():8.2f} {(e <= TOLERANCE).mean():10.1%} {np.mean(inside):7.1%}")
 
 
 def other_bodies(mh, tpose_rotations) -> None:

@@ -11,12 +11,17 @@ from ..core.skeletons import KINECT_V1, Skeleton
 from .features import LABELS, FeaturePoints, find_feature_points
 from .graph import connected_components, mesh_graph
 from .joints import kinect_joints
-from .levels import SkeletonPoints, paper_skeleton
+from .joints_paper import paper_joints
+from .levels import NORMALIZATIONS, SkeletonPoints, paper_skeleton
 from .mirror import asymmetry, fit_mirror_plane, symmetrize_joints
 from .mesh import Mesh, MeshError, nearest_vertex
 from .weights import bone_projection_weights
 
 LEVELS = 4  # the paper's K
+# Joint rules: "fractions" (default: rings at fixed fractions of the body's geodesic length, joints.py; it
+# measures better, benchmarks/bench_autorig.py) or "paper" (the paper's skeleton points, joints_paper.py:
+# there K and the eq. 6 normalization move the joints).
+JOINT_RULES = ("fractions", "paper")
 
 
 @dataclass
@@ -47,7 +52,8 @@ class AutoRig:
         r = self.report
         return (f"auto-rig: {len(self.joints)} joints from a body of {r['body_vertices']} vertices "
                 f"(height {self.height:.3g} units, {r['components']} mesh pieces, {r['bound_vertices']} vertices "
-                f"bound from other pieces), {len(self.paper.points)} skeleton points over {r['levels']} levels, "
+                f"bound from other pieces), {r['joint_rule']} joints, {len(self.paper.points)} skeleton points over "
+                f"{r['levels']} levels ({r['normalization']} normalization), "
                 f"{r['seconds']:.2f} s")
 
 
@@ -61,8 +67,17 @@ def _check_single_body(mesh: Mesh, comp: np.ndarray) -> None:
                         f"({sizes[0]} and {sizes[1]} vertices): several bodies? Rig one character at a time")
 
 
-def autorig(mesh: Mesh, levels: int = LEVELS) -> AutoRig:
-    """Rig a humanoid mesh. Raises MeshError with what was found when no human skeleton can be built."""
+def autorig(mesh: Mesh, levels: int = LEVELS, joints: str = "fractions",
+            normalization: str = "segment") -> AutoRig:
+    """Rig a humanoid mesh. Raises MeshError with what was found when no human skeleton can be built.
+    `joints` picks the joint rule (JOINT_RULES), `normalization` eq. 6's reading (levels.NORMALIZATIONS)."""
+    if joints not in JOINT_RULES:
+        raise ValueError(f"joints {joints!r}: expected one of {JOINT_RULES}")
+    if normalization not in NORMALIZATIONS:
+        raise ValueError(f"normalization {normalization!r}: expected one of {NORMALIZATIONS}")
+    if not 1 <= levels <= 50:
+        raise ValueError(f"levels {levels}: expected 1 to 50 (the paper uses 2-7)")
+    rule = joints
     t0 = time.perf_counter()
     timings = {}
     graph = mesh_graph(mesh.vertices, mesh.faces)
@@ -84,8 +99,9 @@ def autorig(mesh: Mesh, levels: int = LEVELS) -> AutoRig:
     segment = np.argmin(fp.distances, axis=0)
     up_coord = v @ fp.up
     height = float(up_coord.max() - up_coord.min())
-    paper = paper_skeleton(v, bgraph, fp.distances, levels)
-    joints = kinect_joints(v, body_mesh.faces, fp, segment, height)
+    paper = paper_skeleton(v, bgraph, fp.distances, levels, normalization)
+    joints = (paper_joints(v, fp, paper, height) if rule == "paper"
+              else kinect_joints(v, body_mesh.faces, fp, segment, height))
     if not np.all(np.isfinite(joints)):
         raise MeshError(f"{mesh.name}: joint placement failed (non-finite positions)")
     # A body that is its own mirror image gets a mirror-symmetric rig (mirror.py: geodesics measured on a
@@ -108,7 +124,8 @@ def autorig(mesh: Mesh, levels: int = LEVELS) -> AutoRig:
     report = {"body_vertices": int(len(body)), "components": int(comp.max()) + 1,
               "bound_vertices": int(len(others)), "feature_points": {l: v[i].tolist() for l, i in zip(LABELS, fp.vertices)},
               "up": fp.up.tolist(), "front": fp.front.tolist(), "seconds": time.perf_counter() - t0,
-              "timings": timings, "levels": levels, "mirror": mirror, "points_per_level": paper.count_per_level(levels).tolist()}
+              "timings": timings, "levels": levels, "joint_rule": rule,
+              "normalization": normalization, "mirror": mirror, "points_per_level": paper.count_per_level(levels).tolist()}
     return AutoRig(KINECT_V1, joints, index, weight, body, segment, fp, paper, height, report, v)
 
 

@@ -13,6 +13,13 @@ from ..autorig.auto_rigger import bind_mesh
 from ..autorig.weights import bone_segments
 
 AUTORIG_TAG = "kinect_retarget_autorig"
+JOINT_ITEMS = [("FRACTIONS", "Geodesic Fractions", "Rings at fixed fractions of the body's geodesic length, "
+                "moved onto the limbs' axes (default: the more accurate, docs/autorig.md)"),
+               ("PAPER", "Paper's Skeleton Points", "Joints on the chain of the paper's level-set centroids "
+                "(eq. 7-9) with its shoulder/ankle adjustment (§4.2): Levels (K) and Normalization move them")]
+NORMALIZATION_ITEMS = [("SEGMENT", "Per Segment", "Eq. 6 over each feature point's segment: every limb gets K "
+                        "levels (default)"),
+                       ("GLOBAL", "Global (as printed)", "Eq. 6 over all vertices: short limbs get fewer levels")]
 WEIGHT_ITEMS = [("PROJECTION", "Bone Projection", "The paper's bone-projection weights (fast, pure numpy)"),
                 ("HEAT", "Heat (Blender)", "Blender's automatic weights (bone heat); slower, smoother")]
 
@@ -151,9 +158,12 @@ def _roll_back(saved, arm_obj) -> None:
 
 
 def rig_mesh_object(context, mesh_obj: bpy.types.Object, weights: str = "PROJECTION", levels: int = 4,
-                    name: str | None = None, extra=()) -> tuple[bpy.types.Object, AutoRig, str]:
+                    name: str | None = None, extra=(), joints: str = "fractions", normalization: str = "segment",
+                    paper_skeleton: bool = False) -> tuple[bpy.types.Object, AutoRig, str]:
     """Rig `mesh_obj` in place; `extra` mesh objects (clothes, eyes, hair kept apart) are bound to the
-    same armature. Raises MeshError (scene untouched) when no human skeleton can be built."""
+    same armature; with paper_skeleton, the paper's skeleton points and tree are built beside it as a
+    second armature ('<rig>_PaperSkeleton'). Raises MeshError (scene untouched) when no human skeleton
+    can be built."""
     extra = [o for o in extra if o is not mesh_obj and o.type == "MESH" and len(o.data.polygons)
              and not any(m.type == "ARMATURE" for m in o.modifiers)]
     if mesh_obj is None or mesh_obj.type != "MESH":
@@ -163,7 +173,8 @@ def rig_mesh_object(context, mesh_obj: bpy.types.Object, weights: str = "PROJECT
     verts, tris = mesh_world_arrays(mesh_obj)
     if len(tris) == 0:
         raise MeshError(f"{mesh_obj.name!r} has no faces: not a surface mesh")
-    rig = autorig(Mesh(verts, tris, mesh_obj.name), levels=levels)  # may raise: nothing changed yet
+    rig = autorig(Mesh(verts, tris, mesh_obj.name), levels=levels, joints=joints.lower(),
+                  normalization=normalization.lower())  # may raise: nothing changed yet
     collection = mesh_obj.users_collection[0] if mesh_obj.users_collection else context.scene.collection
     arm_obj = build_armature(context, rig, name or f"{mesh_obj.name}_Rig", collection)
     saved = [(o, o.parent, o.matrix_parent_inverse.copy(), o.matrix_world.copy(), {g.name for g in o.vertex_groups})
@@ -183,7 +194,15 @@ def rig_mesh_object(context, mesh_obj: bpy.types.Object, weights: str = "PROJECT
             _parent_with_modifier(obj, arm_obj)
         if extra:
             note += f"; bound {len(extra)} more mesh object(s): {', '.join(o.name for o in extra)}"
+        if paper_skeleton:
+            from .io.paper_skeleton import build_paper_skeleton
+            points = build_paper_skeleton(context, rig.paper, f"{arm_obj.name}_PaperSkeleton", collection)
+            arm_obj["kinect_retarget_paper_skeleton"] = points.name
+            note += f"; paper skeleton: {points.name} ({len(points.data.bones)} connections)"
     except Exception:
+        paper = bpy.data.objects.get(f"{arm_obj.name}_PaperSkeleton")
+        if paper is not None:
+            bpy.data.objects.remove(paper)
         _roll_back(saved, arm_obj)
         raise
     return arm_obj, rig, rig.summary() + note
@@ -198,8 +217,14 @@ class KINECT_RETARGET_OT_autorig_mesh(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     weights: EnumProperty(name="Weights", items=WEIGHT_ITEMS, default="PROJECTION")
-    levels: IntProperty(name="Levels (K)", description="Topological levels of the paper's skeleton points",
-                        default=4, min=2, max=7)
+    joints: EnumProperty(name="Joints", items=JOINT_ITEMS, default="FRACTIONS")
+    levels: IntProperty(name="Levels (K)", description="Topological levels of the paper's skeleton points "
+                        "(moves the joints with the paper's rule; shapes the paper skeleton)", default=4, min=2, max=7)
+    normalization: EnumProperty(name="Normalization", items=NORMALIZATION_ITEMS, default="SEGMENT",
+                                description="Eq. 6: geodesic distance normalized per segment or over all vertices")
+    paper_skeleton: BoolProperty(name="Build Paper Skeleton", default=False,
+                                 description="Also build the paper's skeleton points and their tree as an armature "
+                                             "(one bone per connection) beside the Kinect-named rig")
     rig_name: StringProperty(name="Armature Name", description="Empty: '<mesh>_Rig'", default="")
     bind_selected: BoolProperty(name="Bind Other Selected Meshes", default=True,
                                 description="Clothes, eyes or hair kept as separate objects follow the new rig")
@@ -215,12 +240,26 @@ class KINECT_RETARGET_OT_autorig_mesh(bpy.types.Operator):
             return False
         return True
 
+    def draw(self, context):
+        layout = self.layout
+        layout.prop(self, "weights")
+        layout.prop(self, "joints")
+        layout.prop(self, "paper_skeleton")
+        # K and the normalization act only on the paper's skeleton points: shown only when something uses them
+        col = layout.column()
+        col.active = self.joints == "PAPER" or self.paper_skeleton
+        col.prop(self, "levels")
+        col.prop(self, "normalization")
+        layout.prop(self, "rig_name")
+        layout.prop(self, "bind_selected")
+
     def execute(self, context):
         mesh_obj = context.active_object
         try:
             extra = context.selected_objects if self.bind_selected else ()
             arm_obj, _, summary = rig_mesh_object(context, mesh_obj, self.weights, self.levels,
-                                                  self.rig_name or None, extra)
+                                                  self.rig_name or None, extra, self.joints, self.normalization,
+                                                  self.paper_skeleton)
         except MeshError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
@@ -251,7 +290,8 @@ CLASSES = (KINECT_RETARGET_OT_autorig_mesh,)
 
 
 def autorig_to_file(mesh: Mesh, out_path: str, *, take=None, render_dir: str | None = None, frames: int = 6,
-                    weights: str = "PROJECTION", levels: int = 4) -> dict:
+                    weights: str = "PROJECTION", levels: int = 4, joints: str = "fractions",
+                    normalization: str = "segment", paper_skeleton: bool = False) -> dict:
     """Headless: a fresh scene holding `mesh` rigged (and `take` baked on it), saved to out_path."""
     import os
 
@@ -260,10 +300,14 @@ def autorig_to_file(mesh: Mesh, out_path: str, *, take=None, render_dir: str | N
     scene = context.scene
     obj = new_mesh_object(mesh.name, mesh.vertices, mesh.faces, scene.collection)
     context.view_layer.objects.active = obj
-    arm, rig, summary = rig_mesh_object(context, obj, weights, levels)
+    arm, rig, summary = rig_mesh_object(context, obj, weights, levels, joints=joints,
+                                        normalization=normalization, paper_skeleton=paper_skeleton)
     out = {"out": out_path, "mesh": obj.name, "armature": arm.name, "vertices": len(mesh.vertices),
            "height_m": round(float(np.ptp(mesh.vertices[:, 2])), 4), "summary": summary,
-           "points_per_level": rig.report["points_per_level"]}
+           "points_per_level": rig.report["points_per_level"], "joint_rule": rig.report["joint_rule"],
+           "normalization": rig.report["normalization"]}
+    if paper_skeleton:
+        out["paper_skeleton"] = arm["kinect_retarget_paper_skeleton"]
     render_frames = [scene.frame_current]
     if take is not None:
         from .bake_take import bake_take

@@ -18,8 +18,17 @@ def add_parsers(sub) -> None:
     p.add_argument("--group", help="OBJ group or object to rig (e.g. 'body' for MakeHuman's base.obj)")
     p.add_argument("--weights", choices=("projection", "heat"), default="projection",
                    help="skin weights: the paper's bone projection (default) or Blender's bone heat")
-    p.add_argument("--levels", type=int, default=4, choices=range(2, 8), metavar="K",
-                   help="topological levels of the paper's skeleton points (2-7, default 4)")
+    p.add_argument("--joints", choices=("fractions", "paper"), default="fractions",
+                   help="joint rule: rings at fixed geodesic fractions (default, the more accurate) or the "
+                        "paper's skeleton points with its shoulder/ankle adjustment (docs/autorig.md)")
+    p.add_argument("--levels", type=int, default=None, choices=range(2, 8), metavar="K",
+                   help="topological levels of the paper's skeleton points (2-7, default 4); they move the "
+                        "joints with --joints paper and shape --paper-skeleton")
+    p.add_argument("--normalize", choices=("segment", "global"), default=None,
+                   help="eq. 6's normalization of the geodesic distance: per segment (default) or over all "
+                        "vertices as printed; acts where --levels does")
+    p.add_argument("--paper-skeleton", action="store_true",
+                   help="also build the paper's skeleton points and tree as an armature beside the rig")
     p.add_argument("--keep-transform", action="store_true",
                    help="keep the file's axes and units (default: stand the mesh Z-up, facing -Y, in metres)")
     p.set_defaults(handler=run_autorig)
@@ -33,13 +42,20 @@ def run_autorig(args) -> int:
 
     if not args.out.lower().endswith(".blend"):
         raise ValueError(f"--out {args.out}: the output must be a .blend file")
+    if args.joints == "fractions" and not args.paper_skeleton:
+        unused = [o for o, v in (("--levels", args.levels), ("--normalize", args.normalize)) if v is not None]
+        if unused:  # an option that changes nothing is refused rather than silently ignored
+            raise ValueError(f"{' and '.join(unused)} change(s) only the paper's skeleton points: use them with "
+                             f"--joints paper or --paper-skeleton")
+    args.levels = 4 if args.levels is None else args.levels
+    args.normalize = args.normalize or "segment"
     mesh = load_mesh(args.mesh, group=args.group)
     take = None
     if args.take:
         from ..takes import load_take
         take = load_take(args.take)
         take.metadata.setdefault("name", os.path.splitext(os.path.basename(args.take))[0])
-    rig = autorig(mesh, levels=args.levels)  # not a human: a clear MeshError now, before Blender starts
+    rig = autorig(mesh, levels=args.levels, joints=args.joints, normalization=args.normalize)  # not a human: a clear MeshError now, before Blender starts
     vertices = mesh.vertices
     if not args.keep_transform:
         m = upright_transform(mesh.vertices, np.asarray(rig.features.up), np.asarray(rig.features.front),
@@ -50,6 +66,7 @@ def run_autorig(args) -> int:
 
     summary = autorig_to_file(Mesh(vertices, mesh.faces, name), args.out, take=take, render_dir=args.render,
                               frames=args.frames, weights=args.weights.upper(),
-                              levels=args.levels)
+                              levels=args.levels, joints=args.joints, normalization=args.normalize,
+                              paper_skeleton=args.paper_skeleton)
     print(json.dumps(summary))
     return 0

@@ -58,3 +58,16 @@ def test_blender_exported_files_rig_like_the_source(bpy_empty, shared_data, tmp_
     rig = autorig(load_mesh(path))
     ref = autorig(type(src)(expected, src.faces, "ref"))
     np.testing.assert_allclose(rig.joints, ref.joints, atol=2e-4)
+
+
+def test_autorig_cli_refuses_levels_that_change_nothing(shared_data, tmp_path, capsys):
+    """--levels moves nothing under the fractions rule: refused unless the paper's points are used."""
+    out = tmp_path / "o.blend"
+    mesh = str(shared_data / "meshes" / "makehuman" / "base.obj")
+    assert main(["autorig", mesh, "--group", "body", "--out", str(out), "--levels", "3"]) == 2
+    assert "--levels" in capsys.readouterr().err and not out.exists()
+    assert main(["autorig", mesh, "--group", "body", "--out", str(out), "--joints", "paper", "--levels", "3",
+                 "--paper-skeleton"]) == 0
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert summary["joint_rule"] == "paper" and summary["paper_skeleton"].endswith("_PaperSkeleton")
+    assert len(summary["points_per_level"]) == 3

@@ -159,3 +159,24 @@ def test_failure_after_armature_is_rolled_back(registered, body, monkeypatch):
     assert not bpy.data.armatures or all(a.users == 0 for a in bpy.data.armatures)
     assert [o.type for o in bpy.data.objects] == ["MESH"]
     np.testing.assert_allclose(np.array(obj.matrix_world)[:3, 3], [0.5, 0, 0], atol=1e-6)
+
+
+def test_paper_joints_and_paper_skeleton_built(registered, body):
+    """Joints = Paper: the rig's joints are the paper rule's (K moves them), and the paper's skeleton points
+    come out as a second armature with one bone per connection of their tree."""
+    bpy = registered
+    from kinect_retarget.autorig import Mesh
+    from kinect_retarget.blender.io.paper_skeleton import tree_bones
+    _add_body(bpy, body)
+    assert bpy.ops.kinect_retarget.autorig_mesh(joints="PAPER", levels=5, normalization="GLOBAL",
+                                                paper_skeleton=True) == {"FINISHED"}
+    arm = bpy.context.active_object
+    expected = autorig(Mesh(body[0], body[1]), levels=5, joints="paper", normalization="global")
+    tails = {b.name: np.array(b.tail_local) for b in arm.data.bones}
+    np.testing.assert_allclose(tails["ElbowLeft"], expected.joints[KINECT_V1.index("ElbowLeft")], atol=1e-4)
+    points = bpy.data.objects[arm["kinect_retarget_paper_skeleton"]]
+    assert points.type == "ARMATURE" and len(points.data.bones) == len(expected.paper.points) - 1
+    assert len(tree_bones(expected.paper)) == len(expected.paper.tree)
+    ends = np.array([b.tail_local for b in points.data.bones])
+    assert np.abs(ends[:, None, :] - expected.paper.points[None]).max(axis=2).min(axis=1).max() < 1e-4
+    assert not any(b.use_deform for b in points.data.bones)
