@@ -3,6 +3,7 @@ Armature modifier (paper 003 via kinect_retarget.autorig). One undo step; nothin
 from __future__ import annotations
 
 import json
+from contextlib import contextmanager
 
 import bpy
 import numpy as np
@@ -63,11 +64,7 @@ def build_armature(context, rig: AutoRig, name: str, collection) -> bpy.types.Ob
     obj["kinect_retarget_skeleton"] = rig.skeleton.name
     heads, tails = bone_segments(rig.joints)
     up, front = np.asarray(rig.features.up), np.asarray(rig.features.front)
-    view_layer = context.view_layer
-    previous = view_layer.objects.active
-    view_layer.objects.active = obj
-    bpy.ops.object.mode_set(mode="EDIT")
-    try:
+    with armature_edit(context, obj):
         edit = []
         for j, joint in enumerate(rig.skeleton.joints):
             eb = arm.edit_bones.new(joint)
@@ -79,10 +76,22 @@ def build_armature(context, rig: AutoRig, name: str, collection) -> bpy.types.Ob
         for j, p in enumerate(rig.skeleton.parents):
             if p >= 0:
                 edit[j].parent = edit[p]
+    return obj
+
+
+@contextmanager
+def armature_edit(context, obj: bpy.types.Object):
+    """Edit Mode on `obj` for the block (its edit bones can be made), then Object Mode and the previously
+    active object back, whatever happens."""
+    view_layer = context.view_layer
+    previous = view_layer.objects.active
+    view_layer.objects.active = obj
+    bpy.ops.object.mode_set(mode="EDIT")
+    try:
+        yield obj.data
     finally:
         bpy.ops.object.mode_set(mode="OBJECT")
         view_layer.objects.active = previous
-    return obj
 
 
 def assign_weights(mesh_obj: bpy.types.Object, rig: AutoRig, index: np.ndarray | None = None,

@@ -47,11 +47,8 @@ def build_paper_skeleton(context, sk: SkeletonPoints, name: str, collection) -> 
     obj.show_in_front = True
     collection.objects.link(obj)
     obj["kinect_retarget_paper_points"] = len(sk.points)
-    view_layer = context.view_layer
-    previous = view_layer.objects.active
-    view_layer.objects.active = obj
-    bpy.ops.object.mode_set(mode="EDIT")
-    try:
+    from ..mesh_autorig import armature_edit
+    with armature_edit(context, obj):
         edit = []
         for p, c, parent in tree_bones(sk):
             eb = arm.edit_bones.new(point_name(sk, c))
@@ -62,7 +59,4 @@ def build_paper_skeleton(context, sk: SkeletonPoints, name: str, collection) -> 
             if parent >= 0:
                 eb.parent = edit[parent]
             edit.append(eb)
-    finally:
-        bpy.ops.object.mode_set(mode="OBJECT")
-        view_layer.objects.active = previous
     return obj
