@@ -1,7 +1,11 @@
 """Fixtures for tests that use the real bpy 5.0.1 wheel. bpy is imported inside fixtures only."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
+
+REPO = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture
@@ -72,3 +76,27 @@ def add_unlearnable_parents(bpy, obj, frames: tuple[int, int]):
     var.targets[0].id_type, var.targets[0].id, var.targets[0].data_path = "OBJECT", knob, '["follow"]'
     fc.driver.expression = "var"
     return aim, knob
+
+
+@pytest.fixture
+def generated_live_rig(tmp_path):
+    """The add-on registered and a generated Kinect v2 rig as the sidebar's target, recording into tmp_path
+    without timeline playback. Yields (the first 60 frames of a v2 sample take, the scene's settings)."""
+    import bpy
+    import kinect_retarget
+    from kinect_retarget.blender.io.kinect_rig import build_kinect_rig
+    from kinect_retarget.blender.live import live_runtime
+    from kinect_retarget.core.kinect_rig_layout import median_segment_lengths
+    from kinect_retarget.takes import load_take
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    kinect_retarget.register()
+    take = load_take(REPO / "sample_takes" / "kinect_v2_ges03_drawlines.krtake").slice(slice(0, 60))
+    scene = bpy.context.scene
+    obj = build_kinect_rig(scene, take.skeleton, median_segment_lengths(take), "KinectRig")
+    bpy.context.view_layer.objects.active = obj
+    s = scene.kinect_retarget
+    s.initialised, s.armature, s.record_dir, s.play_on_record = True, obj, str(tmp_path), False
+    yield take, s
+    live_runtime.stop_live(bake=False)
+    kinect_retarget.unregister()
+    bpy.ops.wm.read_factory_settings(use_empty=True)

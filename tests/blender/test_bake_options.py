@@ -149,3 +149,34 @@ def test_operator_defaults_leave_scene_alone_and_options_reach_the_bake(register
     with pytest.raises(RuntimeError, match="holds no sample"):
         bpy.ops.kinect_retarget.bake_take(filepath=TAKE, preset="kinect", use_take_range=True,
                                           range_start=50.0, range_end=60.0)
+
+
+def test_cli_leaves_the_rig_files_scene_alone_and_takes_the_options(bpy_empty, tmp_path):
+    import json
+    import subprocess
+    import sys
+    bpy = bpy_empty
+    _rig(bpy)  # a 24 fps scene, frames 1-250
+    rig = tmp_path / "rig.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(rig))
+    out = tmp_path / "out.blend"
+    r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", TAKE, "--rig", str(rig), "--out", str(out),
+                        "--take-start", "1", "--take-end", "3", "--frame-start", "10", "--step", "2", "--reduce",
+                        "--tolerance-deg", "1", "--tolerance-mm", "2", "--nla"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    result = json.loads(r.stdout.strip().splitlines()[-1])
+    assert result["frame_range"] == [10, 58] and result["keys_removed"] > 0 and result["max_error_deg"] <= 1.0
+    assert result["nla_strip"] == "kinect_v2_ges05_demopoint"
+    bpy.ops.wm.open_mainfile(filepath=str(out))
+    scene = bpy.context.scene
+    assert (scene.render.fps, scene.frame_start, scene.frame_end) == (24, 1, 250)
+    obj = bpy.data.objects["KinectRig"]
+    assert obj.animation_data.action is None and obj.animation_data.nla_tracks[0].strips[0].frame_start == 10
+    r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", TAKE, "--rig", str(rig), "--out", str(out),
+                        "--set-scene-fps", "--extend-range"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    bpy.ops.wm.open_mainfile(filepath=str(out))
+    assert (bpy.context.scene.render.fps, bpy.context.scene.frame_end) == (30, 250)  # 192 frames fit: not shortened
+    r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", TAKE, "--out", str(out), "--step", "0"],
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "key step" in r.stderr

@@ -8,32 +8,16 @@ import time
 import bpy
 import pytest
 
-import kinect_retarget
-from kinect_retarget.blender.io.kinect_rig import build_kinect_rig
 from kinect_retarget.blender.live import live_runtime as live
-from kinect_retarget.core.kinect_rig_layout import median_segment_lengths
 from kinect_retarget.sources import TakePlayback
-from kinect_retarget.takes import load_take
-
-TAKE = "sample_takes/kinect_v2_ges03_drawlines.krtake"
 
 
 @pytest.fixture
-def rig(tmp_path):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    kinect_retarget.register()
-    take = load_take(TAKE).slice(slice(0, 45))
-    scene = bpy.context.scene
-    obj = build_kinect_rig(scene, take.skeleton, median_segment_lengths(take), "KinectRig")
-    bpy.context.view_layer.objects.active = obj
-    s = scene.kinect_retarget
-    s.initialised, s.armature, s.record_dir, s.play_on_record = True, obj, str(tmp_path), False
+def rig(generated_live_rig):
+    take, s = generated_live_rig
     s.bake_on_stop = True
     bpy.ops.ed.undo_push(message="rig made")  # what the user did before going live
-    yield take
-    live.stop_live(bake=False)
-    kinect_retarget.unregister()
-    bpy.ops.wm.read_factory_settings(use_empty=True)
+    return take.slice(slice(0, 45))
 
 
 def _record_until_the_take_ends(take) -> str:

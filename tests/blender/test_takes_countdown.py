@@ -8,34 +8,18 @@ import time
 import bpy
 import pytest
 
-import kinect_retarget
-from kinect_retarget.blender.io.kinect_rig import build_kinect_rig
 from kinect_retarget.blender.live import live_runtime as live
 from kinect_retarget.blender.live import record_countdown
-from kinect_retarget.core.kinect_rig_layout import median_segment_lengths
 from kinect_retarget.sources import TakePlayback
-from kinect_retarget.takes import load_take
-
-TAKE = "sample_takes/kinect_v2_ges03_drawlines.krtake"
 
 
 @pytest.fixture
-def live_rig(tmp_path, monkeypatch):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    kinect_retarget.register()
-    take = load_take(TAKE).slice(slice(0, 60))
-    scene = bpy.context.scene
-    obj = build_kinect_rig(scene, take.skeleton, median_segment_lengths(take), "KinectRig")
-    bpy.context.view_layer.objects.active = obj
-    s = scene.kinect_retarget
-    s.initialised, s.armature, s.record_dir, s.play_on_record = True, obj, str(tmp_path), False
+def live_rig(generated_live_rig, monkeypatch):
+    take, s = generated_live_rig
     now = [100.0]
     monkeypatch.setattr(record_countdown, "clock", lambda: now[0])
     c = live.start_live(bpy.context, source=TakePlayback(take, speed=1.0, loop=True), use_timer=False)
-    yield c, s, now
-    live.stop_live(bake=False)
-    kinect_retarget.unregister()
-    bpy.ops.wm.read_factory_settings(use_empty=True)
+    return c, s, now
 
 
 def _header_funcs():

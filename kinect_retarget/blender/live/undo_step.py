@@ -5,21 +5,16 @@ from __future__ import annotations
 
 import bpy
 
+from .window_context import in_window
+
 BAKE_STEP = "Bake Kinect Recording"
 
 
 def push_undo_step(message: str = BAKE_STEP) -> bool:
     """Push the current state as an undo step named `message` (from timers too, which have no window in their
     context). False when Blender has no undo stack to push to (e.g. while a file loads)."""
-    context = bpy.context
-    wm = context.window_manager
-    window = context.window or (wm.windows[0] if wm is not None and len(wm.windows) else None)
     try:
-        if context.window is None and window is not None:
-            with context.temp_override(window=window):
-                bpy.ops.ed.undo_push(message=message)
-        else:
-            bpy.ops.ed.undo_push(message=message)
+        in_window(lambda: bpy.ops.ed.undo_push(message=message))
     except RuntimeError:
         return False
     return True

@@ -7,6 +7,7 @@ import bpy
 from ...core.take import TakeError
 from ...sources import SourceError
 from ..live import live_runtime, record_countdown
+from ..live.window_context import in_window
 from .properties import target_armature
 
 
@@ -94,14 +95,8 @@ def _record_after_countdown() -> None:
     c = live_runtime.controller()
     if c is None:
         return
-    wm = bpy.context.window_manager
-    window = bpy.context.window or (wm.windows[0] if wm is not None and len(wm.windows) else None)
     try:
-        if window is not None and bpy.context.window is None:
-            with bpy.context.temp_override(window=window, screen=window.screen):
-                c.start_recording(bpy.context)
-        else:
-            c.start_recording(bpy.context)
+        in_window(lambda: c.start_recording(bpy.context))
     except (SourceError, OSError) as exc:
         c.post("ERROR", str(exc))
     live_runtime.redraw_3d_views()
