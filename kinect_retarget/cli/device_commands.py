@@ -11,14 +11,12 @@ import json
 import queue
 import sys
 import time
-from pathlib import Path
 
-import numpy as np
-
-from ..device.disparity_calibration import Calibration
+from ..device.capture_file import calibration_from, save_capture
 from ..device.decode import decode_frame
+from ..device.disparity_calibration import Calibration
 from ..device.errors import KinectError
-from ..device.protocol import TICKS_PER_FRAME, TIMESTAMP_HZ
+from ..device.protocol import TICKS_PER_FRAME, TIMESTAMP_HZ, ticks_between
 
 SIMULATE_HELP = "use the emulated Kinect instead of USB hardware"
 BAD_INPUT, DEVICE_FAILURE = 2, 1
@@ -103,36 +101,16 @@ def run_devices(args) -> int:
 
 
 # --- capture ---------------------------------------------------------------------------------------------------
-def _save(path: str, raws, mms, stamps, lost, calibration: Calibration) -> None:
-    shape = (0, 480, 640)
-    out = Path(path)
-    with open(out, "wb") as f:     # an open file keeps numpy from appending ".npz" to other suffixes
-        np.savez(f, raw=np.array(raws, dtype=np.uint16).reshape(-1, 480, 640) if raws else np.zeros(shape, np.uint16),
-                 mm=np.array(mms, dtype=np.uint16).reshape(-1, 480, 640) if mms else np.zeros(shape, np.uint16),
-                 timestamp=np.array(stamps, dtype=np.int64), lost_packets=np.array(lost, dtype=np.int32),
-                 calibration=json.dumps(calibration.as_dict()),
-                 **{f"calibration_{k}": v for k, v in calibration.as_dict().items() if k != "source"})
-
-
-def _calibration_from(path: str) -> Calibration:
-    try:
-        with np.load(path) as data:
-            fields = json.loads(str(data["calibration"]))
-        return Calibration(**fields)
-    except (OSError, KeyError, ValueError, TypeError) as exc:
-        raise ValueError(f"{path}: no usable calibration in it ({exc})") from exc
-
-
 def _capture_replay(args) -> int:
     from ..device.dump import replay_dump
     frames, assembler, error = replay_dump(args.replay)
     if error is not None and not frames:
         raise error                    # nothing decoded (not a dump at all?): write no empty file
     # a dump holds packets only: the calibration comes from an earlier capture, else typical values
-    calibration = _calibration_from(args.calibration) if args.calibration else Calibration()
+    calibration = calibration_from(args.calibration) if args.calibration else Calibration()
     lut = calibration.raw_to_mm_table()
     raws, mms = zip(*(decode_frame(f, lut) for f in frames)) if frames else ((), ())
-    _save(args.out, list(raws), list(mms), [f.timestamp for f in frames], [f.lost_packets for f in frames],
+    save_capture(args.out, list(raws), list(mms), [f.timestamp for f in frames], [f.lost_packets for f in frames],
           calibration)
     s = assembler.stats
     print(f"{len(frames)} frames decoded from {args.replay} ({s.packets_lost} packets lost, "
@@ -160,13 +138,13 @@ def run_capture(args) -> int:
 def _frame_ticks(timestamp: int, previous: int | None) -> int:
     """Device time a new frame adds to a capture: the step from the previous frame (frames the device
     dropped count too), or one frame period for the first frame and the first after a reconnect."""
-    step = (timestamp - previous) & 0xFFFFFFFF if previous is not None else TICKS_PER_FRAME
+    step = ticks_between(previous, timestamp) if previous is not None else TICKS_PER_FRAME
     return step if 0 < step <= TIMESTAMP_HZ else TICKS_PER_FRAME
 
 
 def _capture_live(args) -> int:
-    from ..device.dump import DumpWriter
     from ..device.depth_stream import STREAMING, DepthStream
+    from ..device.dump import DumpWriter
     backend = _backend(args)
     dump = DumpWriter(args.dump) if args.dump else None
     stream = DepthStream(backend, serial=args.serial, queue_size=64,
@@ -211,7 +189,7 @@ def _capture_live(args) -> int:
     status = stream.status
     if not raws:
         raise KinectError(f"no depth frame was captured ({last_message}); nothing written")
-    _save(args.out, raws, mms, stamps, lost, calibration)
+    save_capture(args.out, raws, mms, stamps, lost, calibration)
     print(f"{len(raws)} frames -> {args.out} (dropped {status.frames_dropped}, "
           f"packets lost {status.packets_lost})" + (f"; packets -> {args.dump}" if dump else ""))
     if stalled:                        # a device failure, even though what came before it was saved

@@ -12,8 +12,7 @@ import sys
 import numpy as np
 
 from ..core.take import TakeError
-from ..device.protocol import TIMESTAMP_HZ, TIMESTAMP_WRAP
-
+from ..device.capture_file import load_capture, times_from
 
 
 def add_parsers(subparsers) -> None:
@@ -27,52 +26,9 @@ def add_parsers(subparsers) -> None:
     p.set_defaults(handler=run_track)
 
 
-def _times_from(data, n: int, path: str) -> np.ndarray:
-    if "times" in data:
-        t = np.asarray(data["times"], dtype=np.float64)
-    elif "timestamp" in data:
-        ticks = np.asarray(data["timestamp"], dtype=np.int64)
-        # device ticks wrap at 2**32: unwrap before converting
-        steps = np.diff(ticks) % TIMESTAMP_WRAP
-        t = np.concatenate([[0.0], np.cumsum(steps)]) / TIMESTAMP_HZ
-    else:
-        t = np.arange(n) / 30.0
-    if t.shape != (n,):
-        raise TakeError(f"{path}: {n} depth frames but {t.shape[0]} timestamps")
-    if n > 1 and np.any(np.diff(t) <= 0):
-        bad = int(np.argmax(np.diff(t) <= 0)) + 1
-        raise TakeError(f"{path}: frame {bad} is not later than frame {bad - 1} (timestamps must increase)")
-    return t
-
-
-def load_capture(path: str):
-    """(mm (F, 480, 640) uint16, times (F,), gravity or None); TakeError names the problem."""
-    try:
-        data = np.load(path, allow_pickle=False)
-    except (OSError, ValueError) as exc:
-        raise TakeError(f"{path}: not a readable depth capture (.npz): {exc}") from None
-    with data:
-        keys = set(data.files)
-        if "mm" in keys:
-            mm = data["mm"]
-        elif "raw" in keys:
-            from ..depth.depth_camera import raw_to_mm
-            mm = raw_to_mm(data["raw"])
-        else:
-            raise TakeError(f"{path}: no depth frames in the capture (expected an array named 'mm' or 'raw'; "
-                            f"found {', '.join(sorted(keys)) or 'nothing'})")
-        if mm.ndim != 3 or mm.shape[1:] != (480, 640):
-            raise TakeError(f"{path}: depth frames have shape {mm.shape}, expected (frames, 480, 640)")
-        if mm.shape[0] == 0:
-            raise TakeError(f"{path}: the capture has no frames")
-        times = _times_from(data, mm.shape[0], path)
-        gravity = np.asarray(data["gravity"], dtype=np.float64) if "gravity" in keys else None
-    return np.asarray(mm), times, gravity
-
-
 def load_replay(path: str):
-    from ..device.disparity_calibration import Calibration
     from ..device.decode import decode_frame
+    from ..device.disparity_calibration import Calibration
     from ..device.dump import replay_dump
     frames, _, err = replay_dump(path)
     if err is not None:
@@ -83,7 +39,7 @@ def load_replay(path: str):
     lut = cal.raw_to_mm_table()
     mm = np.stack([decode_frame(f, lut)[1] for f in frames])   # as capture and live decode them
     ticks = np.array([f.timestamp for f in frames], dtype=np.int64)
-    return mm, _times_from({"timestamp": ticks}, len(frames), path), None
+    return mm, times_from({"timestamp": ticks}, len(frames), path), None
 
 
 def run_track(args) -> int:

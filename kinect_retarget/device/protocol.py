@@ -173,3 +173,9 @@ def depth_packet_flag(index_in_frame: int) -> int:
     if index_in_frame == DEPTH_PACKETS_PER_FRAME - 1:
         return FLAG_DEPTH_EOF
     return FLAG_DEPTH_MOF
+
+
+def ticks_between(earlier, later):
+    """Device clock ticks from `earlier` to `later` (ints or arrays): the 32-bit counter wraps, so a later
+    stamp may be smaller. The one place the wrap is undone (capture files, live depth, the CLI)."""
+    return (later - earlier) % TIMESTAMP_WRAP

@@ -12,7 +12,7 @@ import threading
 
 from ..core.skeletons import KINECT_V1
 from ..depth.skeleton_tracker import SkeletonTracker
-from ..device.protocol import TIMESTAMP_HZ, TIMESTAMP_WRAP
+from ..device.protocol import TIMESTAMP_HZ, ticks_between
 
 
 class DepthSkeletonProducer:
@@ -35,7 +35,7 @@ class DepthSkeletonProducer:
             return None
         if self._last_tick is None:
             self._last_tick = frame.timestamp
-        self._elapsed += (frame.timestamp - self._last_tick) % TIMESTAMP_WRAP   # the device clock wraps
+        self._elapsed += ticks_between(self._last_tick, frame.timestamp)
         self._last_tick = frame.timestamp
         t = self._elapsed / TIMESTAMP_HZ
         mm = frame.mm if frame.mm is not None else frame.calibration.to_mm(frame.raw)
