@@ -97,8 +97,9 @@ def _read_bytes(path: Path, limit: int = -1) -> bytes:
         raise MeshError(f"{path}: cannot read: {e.strerror or e}") from None
 
 
-def load_obj(path: str | Path, group: str | None = None) -> Mesh:
-    """Read an OBJ. With `group`, keep only the faces of that `g`/`o` group (e.g. MakeHuman's 'body')."""
+def read_obj(path: str | Path) -> tuple[np.ndarray, list[list[int]], list[str]]:
+    """An OBJ's vertices (V, 3), polygons (0-based vertex lists, as in the file) and each polygon's `g`/`o`
+    group: the one OBJ parser (meshes here, MakeHuman's body in sim/makehuman_body.py)."""
     path = Path(path)
     verts: list[list[float]] = []
     polys: list[list[int]] = []
@@ -128,21 +129,39 @@ def load_obj(path: str | Path, group: str | None = None) -> Mesh:
             current = line[2:].strip()
     if not verts:
         raise MeshError(f"{path}: no 'v' lines: not an OBJ mesh")
-    if group is not None:
+    return np.asarray(verts), polys, poly_group
+
+
+def group_polygons(path: str | Path, polys: list[list[int]], poly_group: list[str], group: str) -> list[list[int]]:
+    """The polygons of one group; MeshError lists the groups there are when it has none."""
+    keep = [p for p, g in zip(polys, poly_group) if g == group]
+    if not keep:
         names = sorted(set(poly_group))
-        keep = [p for p, g in zip(polys, poly_group) if g == group]
-        if not keep:
-            raise MeshError(f"{path}: no faces in group {group!r} (groups: {', '.join(names[:12])}"
-                            f"{' ...' if len(names) > 12 else ''})")
-        polys = keep
+        raise MeshError(f"{path}: no faces in group {group!r} (groups: {', '.join(names[:12])}"
+                        f"{' ...' if len(names) > 12 else ''})")
+    return keep
+
+
+def mesh_from_obj(path: str | Path, verts: np.ndarray, polys: list[list[int]], poly_group: list[str],
+                  group: str | None = None) -> Mesh:
+    """A triangle Mesh from read_obj's result; with `group`, only that group's faces and the vertices they
+    use (`source_index` maps them back to the file's)."""
+    path = Path(path)
+    if group is not None:
+        polys = group_polygons(path, polys, poly_group, group)
     if not polys:
         raise MeshError(f"{path}: {len(verts)} vertices but no faces: not a surface mesh")
-    full = Mesh(np.asarray(verts), triangulate(polys), path.stem)
+    full = Mesh(verts, triangulate(polys), path.stem)
     if group is None:
         return full
     part, used = full.submesh(np.arange(len(full.faces)), f"{path.stem}:{group}")
     part.source_index = used
     return part
+
+
+def load_obj(path: str | Path, group: str | None = None) -> Mesh:
+    """Read an OBJ. With `group`, keep only the faces of that `g`/`o` group (e.g. MakeHuman's 'body')."""
+    return mesh_from_obj(path, *read_obj(path), group=group)
 
 
 _PLY_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2",

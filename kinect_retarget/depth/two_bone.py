@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.quat import normalize
+
 
 def unit(v):
-    n = np.linalg.norm(v)
-    return v / n if n > 1e-9 else v
+    """v / |v| (core.quat.normalize with this module's threshold)."""
+    return normalize(v, 1e-9)
 
 
 def two_bone_candidates(a: np.ndarray, c: np.ndarray, l1: float, l2: float, n: int = 16):

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.conventions import depth_pixel_to_kinect
 from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED, topological_order
 from ..core.take import Take, nominal_rate
 from .bones import DEFAULT_HEIGHT_M, lengths_from_height
@@ -101,7 +102,8 @@ def lift(tracks: Tracks2D, settings: LiftSettings | None = None, *, scale: np.nd
     measured = present & ~tracks.inferred
 
     # Orthographic image coordinates in Kinect axes (pixels, relative to the principal point).
-    xy = np.stack([-(uv[..., 0] - cam.cx), -(uv[..., 1] - cam.cy)], axis=-1)
+    unit = np.ones(uv.shape[:-1])   # unit depth and focal: pixel offsets in Kinect axes
+    xy = depth_pixel_to_kinect(uv[..., 0], uv[..., 1], unit, 1.0, cam.cx, cam.cy)[..., :2]
     d_vec = xy - xy[:, np.maximum(PARENTS, 0)]
     s = _scale(tracks, st, d_vec, measured, body, lengths) if scale is None else np.asarray(scale, float)
 

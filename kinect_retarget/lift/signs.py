@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.quat import normalize
 from ..core.skeletons import KINECT_V1, Skeleton
 from .geometry import JointLines
 from .viterbi import viterbi
@@ -96,7 +97,7 @@ def group_positions(group: SignGroup, lines: JointLines, anchor: np.ndarray, len
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-9)
+    return normalize(v, 1e-9)
 
 
 def _hinge(a: np.ndarray, b: np.ndarray, axis: np.ndarray) -> np.ndarray:

@@ -4,7 +4,7 @@ blend skinning to pose the mesh from MakeHuman's BVH poses or from CMU motions (
 over by bone correspondence)."""
 from __future__ import annotations
 
-import json
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -12,7 +12,8 @@ import numpy as np
 
 from ..core import quat
 from ..core.skeletons import KINECT_V1
-from ..autorig.mesh import Mesh, load_obj
+from ..autorig.mesh import Mesh, mesh_from_obj
+from .makehuman_body import linear_blend_skinning, read_makehuman
 
 # Kinect v1 joint -> (MakeHuman bone that carries it, how the point is defined from bone heads/tails).
 _REF = {
@@ -57,10 +58,10 @@ class MakeHuman:
 
 
 def load_makehuman(folder: str | Path) -> MakeHuman:
-    folder = Path(folder)
-    full = load_obj(folder / "base.obj")
-    body = load_obj(folder / "base.obj", group="body")
-    sk = json.loads((folder / "default.mhskel").read_text())
+    files = read_makehuman(os.fspath(folder))
+    full = mesh_from_obj(files.obj_path, files.vertices, files.polygons, files.groups)
+    body = mesh_from_obj(files.obj_path, files.vertices, files.polygons, files.groups, group="body")
+    sk = files.skeleton
     joint = {k: full.vertices[v].mean(axis=0) for k, v in sk["joints"].items()}
     names = list(sk["bones"])
     order, placed = [], set()
@@ -75,7 +76,7 @@ def load_makehuman(folder: str | Path) -> MakeHuman:
     heads = np.array([joint[sk["bones"][n]["head"]] for n in order])
     tails = np.array([joint[sk["bones"][n]["tail"]] for n in order])
     w = np.zeros((len(full.vertices), len(order)))
-    for bone, pairs in json.loads((folder / "default_weights.mhw").read_text())["weights"].items():
+    for bone, pairs in files.weights.items():
         if bone in order and pairs:
             p = np.asarray(pairs)
             w[p[:, 0].astype(int), order.index(bone)] = p[:, 1]
@@ -117,10 +118,7 @@ def pose_body(mh: MakeHuman, rotations: np.ndarray) -> Mesh:
     heads, _ = posed_bones(mh, rotations)
     v = mh.full.vertices[mh.body.source_index]
     w = mh.weights[mh.body.source_index]
-    # x' = sum_b w_b (R_b (x - h_b) + h'_b)
-    local = v[:, None, :] - mh.heads[None]
-    moved = np.einsum("bij,vbj->vbi", rotations, local) + heads[None]
-    return Mesh((w[..., None] * moved).sum(axis=1), mh.body.faces, "makehuman-posed")
+    return Mesh(linear_blend_skinning(v, w, rotations, mh.heads, heads), mh.body.faces, "makehuman-posed")
 
 
 def _procrustes(src: np.ndarray, dst: np.ndarray) -> np.ndarray:

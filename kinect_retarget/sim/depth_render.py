@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.conventions import kinect_to_depth_pixel
+from ..core.conventions import depth_pixel_to_kinect, kinect_to_depth_pixel
 from ..device.depth_unpack import NO_READING_RAW
 from ..depth.depth_camera import DepthCamera, metres_to_raw
 
@@ -73,7 +73,7 @@ def surface_points(vertices: np.ndarray, quads: np.ndarray, groups) -> np.ndarra
 def room_depth(room: Room, cam: DepthCamera, tilt_deg: float = 0.0) -> np.ndarray:
     """Depth (H, W) of floor, back wall and boxes; the camera is pitched down by tilt_deg."""
     v, u = np.mgrid[0:cam.height, 0:cam.width].astype(np.float64)
-    d = np.stack([-(u - cam.cx) / cam.f, -(v - cam.cy) / cam.f, np.ones_like(u)], axis=-1)  # z = 1 rays
+    d = depth_pixel_to_kinect(u, v, np.ones_like(u), cam.f, cam.cx, cam.cy)  # z = 1 rays
     dw = d @ _tilt(tilt_deg).T  # ray directions in the level (world-aligned) frame
     t = np.full(u.shape, np.inf)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -110,7 +110,7 @@ def kinect_artifacts(depth: np.ndarray, cam: DepthCamera, rng: np.random.Generat
     # Projector shadow: reproject every point into the projector (shifted along X); hidden points vanish.
     v, u = np.nonzero(valid)
     zz = z[v, u]
-    x = -(u - cam.cx) * zz / cam.f
+    x = depth_pixel_to_kinect(u, v, zz, cam.f, cam.cx, cam.cy)[:, 0]
     up = np.round(cam.cx - cam.f * (x - cam.projector_x) / zz).astype(np.int64)
     inside = (up >= 0) & (up < w)
     key = v * w + np.clip(up, 0, w - 1)

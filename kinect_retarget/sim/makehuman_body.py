@@ -13,6 +13,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..autorig.mesh import group_polygons, read_obj
+
 # Drivers: name -> (parent driver, MakeHuman bones that belong to it). Bones not listed follow the nearest
 # listed ancestor (face bones follow the head, fingers the hand, toes the foot).
 DRIVERS: dict[str, tuple[str | None, tuple[str, ...]]] = {
@@ -41,17 +43,28 @@ class BodyModel:
     joints: dict                # MakeHuman joint name -> (3,) rest position
 
 
-def _read_obj_body(path: str) -> tuple[np.ndarray, np.ndarray]:
-    verts, faces, group = [], [], None
-    with open(path, "r", encoding="utf-8") as fh:
-        for line in fh:
-            if line.startswith("v "):
-                verts.append(line.split()[1:4])
-            elif line.startswith("g "):
-                group = line.split()[1]
-            elif line.startswith("f ") and group == "body":
-                faces.append([int(p.split("/")[0]) - 1 for p in line.split()[1:]])
-    return np.asarray(verts, dtype=np.float64) * 0.1, np.asarray(faces, dtype=np.int64)
+@dataclass(frozen=True)
+class MakeHumanFiles:
+    """MakeHuman's base mesh as shipped (kinect_retarget/assets/makehuman): read once, used by the depth
+    renderer's body (load_body) and the auto-rig check (sim/autorig_scoring.load_makehuman)."""
+    vertices: np.ndarray        # (V, 3) decimetres, OBJ axes (Y up, facing +Z)
+    polygons: list              # 0-based vertex lists, as in base.obj
+    groups: list                # each polygon's OBJ group ('body' is the skin)
+    skeleton: dict              # default.mhskel
+    weights: dict               # default_weights.mhw "weights": bone -> [[vertex, weight], ...]
+    obj_path: str
+
+
+@lru_cache(maxsize=2)
+def read_makehuman(folder: str) -> MakeHumanFiles:
+    """base.obj, default.mhskel and default_weights.mhw from `folder` (the one MakeHuman reader)."""
+    obj = os.path.join(folder, "base.obj")
+    verts, polys, groups = read_obj(obj)
+    with open(os.path.join(folder, "default.mhskel"), encoding="utf-8") as fh:
+        skel = json.load(fh)
+    with open(os.path.join(folder, "default_weights.mhw"), encoding="utf-8") as fh:
+        weights = json.load(fh)["weights"]
+    return MakeHumanFiles(verts, polys, groups, skel, weights, obj)
 
 
 def _driver_of_bone(bones: dict) -> dict[str, str]:
@@ -68,11 +81,10 @@ def _driver_of_bone(bones: dict) -> dict[str, str]:
 @lru_cache(maxsize=2)
 def load_body(mesh_dir: str) -> BodyModel:
     """Load base.obj, default.mhskel and default_weights.mhw from `mesh_dir` (kinect_retarget/assets/makehuman)."""
-    verts_all, faces = _read_obj_body(os.path.join(mesh_dir, "base.obj"))
-    with open(os.path.join(mesh_dir, "default.mhskel"), encoding="utf-8") as fh:
-        skel = json.load(fh)
-    with open(os.path.join(mesh_dir, "default_weights.mhw"), encoding="utf-8") as fh:
-        wfile = json.load(fh)["weights"]
+    files = read_makehuman(os.fspath(mesh_dir))
+    verts_all = files.vertices * 0.1    # decimetres -> metres
+    faces = np.asarray(group_polygons(files.obj_path, files.polygons, files.groups, "body"), dtype=np.int64)
+    skel, wfile = files.skeleton, files.weights
     joints = {k: verts_all[v].mean(axis=0) for k, v in skel["joints"].items()}
     used = np.unique(faces)
     remap = np.full(len(verts_all), -1)
@@ -89,3 +101,14 @@ def load_body(mesh_dir: str) -> BodyModel:
     w = np.where(total > 0, w / np.maximum(total, 1e-12), np.eye(len(DRIVER_NAMES))[0])
     bone_joint = {b: (joints[v["head"]], joints[v["tail"]]) for b, v in skel["bones"].items()}
     return BodyModel(verts_all[used], remap[faces], w, {"joints": joints, "bones": bone_joint})
+
+
+def linear_blend_skinning(rest_vertices: np.ndarray, weights: np.ndarray, rotations: np.ndarray,
+                          rest_origins: np.ndarray, posed_origins: np.ndarray) -> np.ndarray:
+    """x' = sum_d w_d (R_d (x - o_d) + o'_d): vertices (V, 3), weights (V, D), rotations (..., D, 3, 3) about
+    rest origins (D, 3) moved to (..., D, 3) -> (..., V, 3). The depth renderer's drivers and the auto-rig
+    check's MakeHuman bones are both posed with it."""
+    local = rest_vertices[:, None, :] - rest_origins[None]                                  # (V, D, 3)
+    moved = np.einsum("...dij,vdj->...vdi", rotations, local) + posed_origins[..., None, :, :]
+    return np.einsum("vd,...vdi->...vi", weights, moved)
+

@@ -13,7 +13,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.skeletons import KINECT_V1
-from .makehuman_body import DRIVER_NAMES, DRIVERS, BodyModel
+from ..core.joint_frames import frame_from_y_hint
+from ..core.quat import normalize
+from .makehuman_body import DRIVER_NAMES, DRIVERS, BodyModel, linear_blend_skinning
 
 # Canonical mocap points -> candidate BVH joint names (CMU "max" release first, then the MotionBuilder one).
 _CMU_ALIASES = {
@@ -81,20 +83,9 @@ _KINECT_POINTS = {
 _KINECT_POINTS = {k: _KINECT_POINTS[k] for k in KINECT_V1.joints}
 
 
-def _unit(v):
-    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
-
-
-def _frame(up, lateral):
-    """Rotation matrices (..., 3, 3) with columns (lateral', up, forward) from two directions."""
-    y = _unit(up)
-    x = _unit(lateral - np.sum(lateral * y, -1, keepdims=True) * y)
-    return np.stack([x, y, np.cross(x, y)], axis=-1)
-
-
 def _swing(a, b):
     """Smallest rotations (..., 3, 3) turning unit vectors a onto b (Rodrigues)."""
-    a, b = _unit(a), _unit(b)
+    a, b = normalize(a), normalize(b)
     v = np.cross(a, b)
     c = np.sum(a * b, -1)
     k = np.zeros(v.shape + (3,))
@@ -114,11 +105,8 @@ class PosedSequence:
     def vertices(self, body: BodyModel, frames=None) -> np.ndarray:
         """(F, V, 3) linear-blend-skinned skin vertices."""
         sel = slice(None) if frames is None else frames
-        r, o = self.rotations[sel], self.origins_posed[sel]
-        local = body.rest_vertices[None, :, None, :] - self.origins_rest[None, None]       # (1, V, D, 3)
-        moved = np.einsum("fdij,fvdj->fvdi", r, np.broadcast_to(local, (r.shape[0],) + local.shape[1:]))
-        moved += o[:, None]
-        return np.einsum("vd,fvdi->fvi", body.weights, moved)
+        return linear_blend_skinning(body.rest_vertices, body.weights, self.rotations[sel], self.origins_rest,
+                                     self.origins_posed[sel])
 
 
 def pose_from_points(body: BodyModel, cmu: dict[str, np.ndarray]) -> PosedSequence:
@@ -129,13 +117,13 @@ def pose_from_points(body: BodyModel, cmu: dict[str, np.ndarray]) -> PosedSequen
     leg = lambda p: (np.linalg.norm(p["hip.L"] - p["knee.L"], axis=-1) + np.linalg.norm(p["knee.L"] - p["ankle.L"], axis=-1))
     scale = float(leg(rest) / np.median(leg(cmu)))
     rot: dict[str, np.ndarray] = {}
-    rest_pelvis = _frame(rest["chest"] - rest["hips"], rest["hip.L"] - rest["hip.R"])
-    rot["pelvis"] = _frame(cmu["chest"] - hips_c, cmu["hip.L"] - cmu["hip.R"]) @ rest_pelvis.T
-    rest_chest = _frame(rest["neck"] - rest["chest"], rest["shoulder.L"] - rest["shoulder.R"])
-    rot["chest"] = _frame(cmu["neck"] - cmu["chest"], cmu["shoulder.L"] - cmu["shoulder.R"]) @ rest_chest.T
-    lat = _unit(cmu["hip.L"] - cmu["hip.R"]) + _unit(cmu["shoulder.L"] - cmu["shoulder.R"])
-    rest_abd = _frame(rest["neck"] - rest["hips"], (rest["hip.L"] - rest["hip.R"]) * 2)
-    rot["abdomen"] = _frame(cmu["neck"] - hips_c, lat) @ rest_abd.T
+    rest_pelvis = frame_from_y_hint(rest["chest"] - rest["hips"], rest["hip.L"] - rest["hip.R"])
+    rot["pelvis"] = frame_from_y_hint(cmu["chest"] - hips_c, cmu["hip.L"] - cmu["hip.R"]) @ rest_pelvis.T
+    rest_chest = frame_from_y_hint(rest["neck"] - rest["chest"], rest["shoulder.L"] - rest["shoulder.R"])
+    rot["chest"] = frame_from_y_hint(cmu["neck"] - cmu["chest"], cmu["shoulder.L"] - cmu["shoulder.R"]) @ rest_chest.T
+    lat = normalize(cmu["hip.L"] - cmu["hip.R"]) + normalize(cmu["shoulder.L"] - cmu["shoulder.R"])
+    rest_abd = frame_from_y_hint(rest["neck"] - rest["hips"], (rest["hip.L"] - rest["hip.R"]) * 2)
+    rot["abdomen"] = frame_from_y_hint(cmu["neck"] - hips_c, lat) @ rest_abd.T
     rot["head"] = _swing(np.einsum("fij,j->fi", rot["chest"], rest["head"] - rest["neck"]),
                          cmu["head"] - cmu["neck"]) @ rot["chest"]
     for d in DRIVER_NAMES:

@@ -20,17 +20,16 @@ from kinect_retarget.core.take import Take
 from kinect_retarget.core.performer_calibration import PROPERTY as CALIBRATION
 from kinect_retarget.sources import TakePlayback
 from kinect_retarget.sources.frame_source import FrameSource
-from kinect_retarget.takes import krtake
+from kinect_retarget.takes import kinect_v2_csv, krtake
 
 REPO_SAMPLE = Path(__file__).resolve().parents[2] / "sample_takes" / "kinect_v2_ges03_drawlines.krtake"
 
 
 def _csv_take(path, frames=None) -> Take:
-    a = np.array([[float(v) for v in line.strip().split(",") if v] for line in open(path) if line.strip()])
-    a = a[:frames] if frames else a
-    block = a[:, 1:].reshape(len(a), 25, 4)
-    return Take(KINECT_V2, np.round(block[..., :3], 5), block[..., 3].astype(np.uint8), (a[:, 0] - a[0, 0]) / 1e7,
-                30.0)
+    """The KinectReader CSV through the package's reader, cut to `frames`, positions at .krtake precision."""
+    take = kinect_v2_csv.read(path)
+    n = frames or take.frame_count
+    return Take(take.skeleton, np.round(take.positions[:n], 5), take.states[:n], take.times[:n], take.rate)
 
 
 @pytest.fixture

@@ -8,25 +8,16 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from kinect_retarget.core.skeletons import KINECT_V2, NOT_TRACKED
+from kinect_retarget.core.skeletons import NOT_TRACKED
 from kinect_retarget.core.take import Take
-from kinect_retarget.takes import krtake
+from kinect_retarget.takes import kinect_v2_csv, krtake
 
 
 def read_kinectreader_csv(path, frames: int | None = None) -> Take:
-    """Microsoft KinectReader CSV (100 ns ticks, then 25 x (x, y, z, state)); trailing commas allowed."""
-    rows = []
-    with open(path, encoding="utf-8") as fh:
-        for line in fh:
-            vals = [v for v in line.strip().split(",") if v != ""]
-            if vals:
-                rows.append([float(v) for v in vals])
-            if frames and len(rows) >= frames:
-                break
-    a = np.asarray(rows)
-    block = a[:, 1:].reshape(len(a), 25, 4)
-    return Take(KINECT_V2, block[..., :3], block[..., 3].astype(np.uint8), (a[:, 0] - a[0, 0]) / 1e7, 30.0,
-                "kinectreader_csv")
+    """Microsoft KinectReader CSV through the package's own reader, cut to `frames`."""
+    take = kinect_v2_csv.read(path)
+    n = frames or take.frame_count
+    return Take(take.skeleton, take.positions[:n], take.states[:n], take.times[:n], take.rate, take.source_format)
 
 
 @pytest.fixture
