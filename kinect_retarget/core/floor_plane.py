@@ -93,6 +93,8 @@ def fit_floor(pos: np.ndarray, feet, guess: np.ndarray, stature: float) -> tuple
     up in the air is not a second floor."""
     if not stature > 0:
         return None, "the figure has no height"
+    if pos.shape[0] < MIN_CONTACTS:
+        return None, f"{pos.shape[0]} frame(s): too few to find the floor (at least {MIN_CONTACTS})"
     depth = min(len(feet[0]), len(feet[1]))
     nodes = list(feet[0][:depth]) + list(feet[1][:depth])
     pts = pos[:, nodes].reshape(-1, 3)

@@ -93,7 +93,7 @@ def test_head_over_feet_alone_gets_these_wrong(tmp_path, source, name, monkeypat
 @pytest.mark.parametrize("name, min_spread, reason", [
     ("cmu_01_01.bvh", None, "the feet stay on a patch too small to level"),  # stands in place
     ("kinect_openni_nite.bvh", None, "the feet stay on a patch too small to level"),
-    ("biovision_example.bvh", None, "2 frames with a foot on the floor"),
+    ("biovision_example.bvh", None, "2 frame(s): too few to find the floor"),
     # a dance on one spot: with the spread check off, the plane through its feet is 30 degrees off level, and
     # the figure never stands up straight on it, which rejects it too
     ("cmu_131_03.bvh", 0.0, "the figure never stands up on the floor fitted under its feet (at best 20 degrees"),
