@@ -27,6 +27,19 @@ def _bake(obj, take, hands="auto"):
     return res, messages[-1]
 
 
+def _toward_palm(obj, hand, side, finger_base):
+    """Degrees a finger's first segment is turned from the hand's length toward the palm's side (the side
+    the thumb sits on), about the hand's curl axis."""
+    from kinect_retarget.blender.io.finger_rig import hand_rig
+    rig = hand_rig(obj, hand, side)
+    m = np.array(obj.pose.bones[hand].matrix)[:3, :3]
+    m /= np.linalg.norm(m, axis=0)
+    palm = m @ np.cross(rig.curl_local, [0.0, 1.0, 0.0])  # curl = Y x palm
+    pb = obj.pose.bones[finger_base]
+    d = np.array(pb.tail) - np.array(pb.head)
+    return float(np.degrees(np.arctan2(palm @ d, m[:, 1] @ d)))
+
+
 def _thumb_side_errors(bpy, obj, res, take):
     """Degrees between the hand's thumb side (its rest thumb side carried by the posed hand) and the
     performer's hand -> thumb, both seen across the hand's own axis."""
@@ -51,6 +64,7 @@ def test_v2_hands_roll_to_the_thumb_and_curl_from_hand_states(metarig, shared_da
     bpy = __import__("bpy")
     take = load_take(shared_data / "kinect_v2" / "recorded_skeleton.json")
     assert take.hand_states is not None
+    rest_tilt = _toward_palm(metarig, "hand.L", "Left", "f_middle.01.L")
     res, msg = _bake(metarig, take)
     assert "hands: 30 finger bones keyed" in msg and "hand states" in msg
     on = _thumb_side_errors(bpy, metarig, res, take)
@@ -63,6 +77,8 @@ def test_v2_hands_roll_to_the_thumb_and_curl_from_hand_states(metarig, shared_da
             bpy.context.scene.frame_set(int(m.frames[i]))
             pb = metarig.pose.bones
             reach[state].append(np.linalg.norm(np.array(pb["f_middle.03.L"].tail) - np.array(pb["f_middle.01.L"].head)))
+            if state == CLOSED:  # curled toward the palm, not backwards
+                assert _toward_palm(metarig, "hand.L", "Left", "f_middle.01.L") > rest_tilt + 30
     assert reach[OPEN] and reach[CLOSED] and np.mean(reach[CLOSED]) < 0.7 * np.mean(reach[OPEN])
     # smooth: no finger joint turns by more than 25 degrees from one key to the next
     k = m.bone_names.index("f_middle.02.L")
@@ -133,3 +149,31 @@ def test_live_hands_equal_the_bake_of_the_recording(metarig, tmp_path):
     finally:
         live.stop_live(bake=False)
         kinect_retarget.unregister()
+
+
+def test_mixamo_named_fingers_on_a_real_skeleton(bpy_empty, shared_data):
+    """MakeHuman's skeleton (its own A-pose hands and bone rolls) under Mixamo's names, fingers included."""
+    from .test_makehuman_rig import RENAMES, build_makehuman_armature
+    bpy = bpy_empty
+    obj = build_makehuman_armature(bpy, shared_data)
+    names = dict(RENAMES["mixamo"])
+    for s, side in (("L", "Left"), ("R", "Right")):
+        for n, finger in enumerate(("Thumb", "Index", "Middle", "Ring", "Pinky"), start=1):
+            names.update({f"finger{n}-{i}.{s}": f"mixamorig:{side}Hand{finger}{i}" for i in (1, 2, 3)})
+    for old, new in names.items():
+        obj.data.bones[old].name = new
+    take = load_take(shared_data / "kinect_v2" / "recorded_skeleton.json")
+    rest_tilt = _toward_palm(obj, "mixamorig:LeftHand", "Left", "mixamorig:LeftHandMiddle1")
+    res, msg = _bake(obj, take)
+    assert res.preset == "mixamo" and "hands: 30 finger bones keyed" in msg
+    m, pb = res.motion, obj.pose.bones
+    reach = {OPEN: [], CLOSED: []}
+    for i in range(10, len(m.frames)):
+        state = int(take.hand_states[m.samples[i], 0])
+        if state in reach and int(take.hand_states[m.samples[i - 10], 0]) == state:
+            bpy.context.scene.frame_set(int(m.frames[i]))
+            tip = np.array(pb["mixamorig:LeftHandMiddle3"].tail) - np.array(pb["mixamorig:LeftHandMiddle1"].head)
+            reach[state].append(np.linalg.norm(tip))
+            if state == CLOSED:  # curled toward the palm, not backwards
+                assert _toward_palm(obj, "mixamorig:LeftHand", "Left", "mixamorig:LeftHandMiddle1") > rest_tilt + 30
+    assert np.mean(reach[CLOSED]) < 0.8 * np.mean(reach[OPEN])
