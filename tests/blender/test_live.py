@@ -315,6 +315,26 @@ def test_exact_live_on_a_rig_with_fallback_bones(registered, tmp_path):
     assert max(moving) < 0.001
 
 
+def test_fallback_bones_without_exact_follow_one_frame_late(registered):
+    """Without the Exact option a fallback parent is read from the last evaluation: a held pose is exact
+    once the rig has been evaluated with it, and no armature copy is kept."""
+    from .conftest import add_unlearnable_parents
+    from kinect_retarget.takes import load_take
+
+    take = load_take(REPO_SAMPLE)
+    obj = build_kinect_rig(bpy.context.scene, take.skeleton, median_segment_lengths(take), "KinectRig")
+    add_unlearnable_parents(bpy, obj, (1, 2))
+    s = bpy.context.scene.kinect_retarget
+    s.initialised, s.armature, s.preset, s.filter, s.exact_constrained = True, obj, "kinect", "none", False
+    src = _Manual(take.skeleton, 30.0)
+    c = live.start_live(bpy.context, source=src, use_timer=False)
+    assert c.model.fallback and not c.exact
+    held = _live_error_while_moving(obj, c, src, take, [60] * 3)  # the same frame three times
+    assert c.evaluator is None and len(bpy.data.scenes) == 1
+    live.stop_live(bake=False)
+    assert held[-1] < 0.001
+
+
 def test_mapping_table_save_load_and_disabled_rows_drive_nothing(scene_with_rig, tmp_path):
     scene, obj, take, _ = scene_with_rig
     s = scene.kinect_retarget
