@@ -57,7 +57,7 @@ def make_pipeline(obj: bpy.types.Object, skeleton: Skeleton, preset: str = "auto
                   settings: RetargetSettings | None = None) -> tuple[RetargetPipeline, str]:
     """The pipeline from `skeleton` onto armature `obj` (bake and live), and the preset used."""
     rig = target_rig_from_object(obj)
-    used, mapping = build_mapping(preset, rig.bone_names, overrides)
+    used, mapping = build_mapping(preset, rig.bone_names, overrides, rig)
     return RetargetPipeline(skeleton, rig, mapping, settings), used
 
 

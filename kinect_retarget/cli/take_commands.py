@@ -14,8 +14,12 @@ from ..takes import load_take
 
 
 def add_parsers(sub) -> None:
-    p = sub.add_parser("info", help="print format, skeleton, frames, duration, rate, tracked fraction of a take")
-    p.add_argument("take")
+    p = sub.add_parser("info", help="print format, skeleton, frames, duration, rate, tracked fraction of a take; "
+                                    "with --rig, the bone mapping of a rig")
+    p.add_argument("take", nargs="?")
+    p.add_argument("--rig", help=".blend: print which bone drives which Kinect joint (preset, or found by structure)")
+    p.add_argument("--armature", help="armature object name in --rig (default: the only armature)")
+    p.add_argument("--preset", choices=PRESET_NAMES, default="auto", help="with --rig: the preset to show")
     p.add_argument("--json", action="store_true", help="one JSON object instead of text")
     p.set_defaults(handler=run_info)
 
@@ -95,7 +99,13 @@ def dropped_summary(meta: dict) -> dict:
 
 
 def run_info(args) -> int:
-    info = take_summary(args.take)
+    if not args.take and not args.rig:
+        raise ValueError("info needs a take, or --rig RIG.blend")
+    if args.rig:
+        from ..blender.io.rig_mapping_report import rig_mapping_summary
+        info = rig_mapping_summary(args.rig, args.armature, args.preset)
+    else:
+        info = take_summary(args.take)
     if args.json:
         print(json.dumps(info))
     else:

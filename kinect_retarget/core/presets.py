@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+from pathlib import Path
 
 from .skeletons import KINECT_V1, KINECT_V2
 
@@ -22,6 +23,26 @@ def _sides(table: dict[str, str], left: str, right: str) -> dict[str, str]:
         else:
             out[bone] = joint
     return out
+
+
+PRESET_DIR = Path(__file__).resolve().parent.parent / "assets" / "presets"
+
+
+def load_preset_files(folder: Path = PRESET_DIR) -> dict[str, dict[str, str]]:
+    """Presets kept as data: each JSON file {"name", "source", "sides": [left tag, right tag], "bones":
+    {bone: joint}}, '{s}' in a bone name standing for the side tag and '{S}' in a joint for Left/Right."""
+    out = {}
+    for path in sorted(folder.glob("*.json")):
+        data = json.loads(path.read_text(encoding="utf-8"))
+        left, right = data.get("sides", ("", ""))
+        out[data["name"]] = _sides(data["bones"], left, right)
+        PRESET_INFO[data["name"]] = {k: v for k, v in data.items() if k not in ("name", "bones", "sides")}
+    return out
+
+
+# per preset: "source" (where the names come from), "root_motion_bone" (the rig's floor-level root bone that
+# carries root motion), "fingerprint" (bones only this preset's rigs have: breaks ties between name sets)
+PRESET_INFO: dict[str, dict] = {"rigify": {"root_motion_bone": "root"}, "rigify-metarig": {}}
 
 
 KINECT = {**{j: j for j in KINECT_V1.joints}, **{j: j for j in KINECT_V2.joints}}
@@ -59,21 +80,23 @@ HANIM = {  # H-Anim humanoid: a bone is named after the joint at its head
 }
 
 MAKEHUMAN = {  # MakeHuman default skeleton (default.mhskel); twist halves (…02) stay at rest
-    "root": "HipCenter", "spine04": "Spine", "spine02": "ShoulderCenter", "neck01": "Neck", "head": "Head",
+    "root": "HipCenter", "spine04": "Spine", "spine01": "ShoulderCenter", "neck01": "Neck", "head": "Head",
     **_sides({"clavicle{s}": "Shoulder{S}", "upperarm01{s}": "Elbow{S}", "lowerarm01{s}": "Wrist{S}",
               "wrist{s}": "Hand{S}", "pelvis{s}": "Hip{S}", "upperleg01{s}": "Knee{S}",
               "lowerleg01{s}": "Ankle{S}", "foot{s}": "Foot{S}"}, ".L", ".R"),
 }
 
 PRESETS = {"kinect": KINECT, "rigify": RIGIFY, "rigify-metarig": RIGIFY_METARIG, "mixamo": MIXAMO,
-           "hanim": HANIM, "makehuman": MAKEHUMAN}
-PRESET_NAMES = ("auto",) + tuple(PRESETS)
+           "hanim": HANIM, "makehuman": MAKEHUMAN, **load_preset_files()}
+STRUCTURE = "structure"  # no names: the armature's hierarchy and rest pose (core/armature_mapping.py)
+PRESET_NAMES = ("auto",) + tuple(PRESETS) + (STRUCTURE,)
 
 
 def detect_preset(bone_names) -> str:
     """The preset naming the most of these bones (ties: the order of PRESETS); raises when none fits."""
     names = set(bone_names)
-    scores = {p: sum(b in names for b in table) for p, table in PRESETS.items()}
+    scores = {p: sum(b in names for b in table) + 0.5 * all(b in names for b in PRESET_INFO.get(p, {}).get(
+        "fingerprint", ("",))) for p, table in PRESETS.items()}
     best = max(scores, key=lambda p: scores[p])
     if scores[best] < 6:
         raise ValueError("no bone-mapping preset fits this armature (found at most "
@@ -112,11 +135,34 @@ def mapping_problems(bone_names, overrides: dict[str, str] | None) -> list[str]:
     return problems
 
 
-def build_mapping(preset: str, bone_names, overrides: dict[str, str] | None = None) -> tuple[str, dict]:
-    """(preset actually used, mapping) for an armature's bones; overrides win, '' unmaps."""
-    used = detect_preset(bone_names) if preset == "auto" else preset
-    if used not in PRESETS:
+def structure_mapping(rig) -> dict[str, str]:
+    """The mapping of a TargetRig found from its hierarchy and rest pose (ValueError: not a humanoid)."""
+    from .armature_mapping import structure_mapping_for
+    return structure_mapping_for(rig.bone_names, rig.parents, rig.heads, rig.tails).mapping
+
+
+def build_mapping(preset: str, bone_names, overrides: dict[str, str] | None = None,
+                  rig=None) -> tuple[str, dict]:
+    """(preset actually used, mapping) for an armature's bones; overrides win, '' unmaps. With the rig
+    (a TargetRig), 'structure' maps it by its structure, and so does 'auto' when no preset fits its names."""
+    used = preset
+    if preset == "auto":
+        try:
+            used = detect_preset(bone_names)
+        except ValueError as exc:
+            if rig is None:
+                raise
+            used, names_error = STRUCTURE, str(exc)
+    if used == STRUCTURE:
+        if rig is None:
+            raise ValueError("the structure mapping needs the armature's rest pose")
+        try:
+            mapping = structure_mapping(rig)
+        except ValueError as exc:
+            raise ValueError(f"{names_error}; by structure: {exc}" if preset == "auto" else str(exc)) from None
+    elif used not in PRESETS:
         raise ValueError(f"unknown preset {preset!r} (choose from {', '.join(PRESET_NAMES)})")
-    mapping = dict(PRESETS[used])
+    else:
+        mapping = dict(PRESETS[used])
     mapping.update(overrides or {})
     return used, {k: v for k, v in mapping.items() if v}

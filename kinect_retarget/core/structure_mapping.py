@@ -16,6 +16,8 @@ API
   forward) and twist nodes are found as the nodes that never bend; without them the rest pose is the only
   frame.
 * ``end_site``: optional (N,) bool, True for nodes that only mark where a chain ends (BVH End Site).
+* ``armature``: True for a rest pose with no take (core/armature_mapping.py): only true zero-length nodes are
+  helpers, and the limbs' joints are chosen among twist nodes inside the chains (core/rest_limbs.py).
 
 A node is a point: for BVH a joint or end site; for a Blender armature pass every bone's head as a node
 (parent = the parent bone's head node) plus one node for the tail of each bone without children
@@ -37,11 +39,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .floor_plane import estimate_up
+from .rest_limbs import best_triple, fanout, rest_leg, wrist_fan
 from .skeletons import KINECT_V1
 from .structure_names import kinect_names, name_side
 
 ROLES = KINECT_V1.joints
 SHORT = 0.03        # a segment shorter than this fraction of the figure's size is a zero-length helper
+SHORT_REST = 0.004  # ... in armature mode (an armature's short bones are real: MakeHuman's upperarm01)
 BIG_BRANCH = 0.15   # a pelvis branch (spine, leg) reaches at least this fraction of the figure's size
 NECK_BRANCH = 0.08  # a chest branch (arm, neck) reaches at least this much
 FINGER = 0.015      # a finger base at least this far from the wrist stands for the hand (not a carpal node)
@@ -90,7 +94,7 @@ class StructureMapping:
         return out
 
 
-def map_structure(names, parents, rest, frames=None, end_site=None) -> StructureMapping:
+def map_structure(names, parents, rest, frames=None, end_site=None, armature=False) -> StructureMapping:
     names = [str(n) for n in names]
     parents = np.asarray(parents, dtype=np.int64)
     rest = np.asarray(rest, dtype=np.float64)
@@ -101,12 +105,14 @@ def map_structure(names, parents, rest, frames=None, end_site=None) -> Structure
     if pos.ndim != 3 or pos.shape[1:] != (n, 3) or not np.all(np.isfinite(pos)):
         raise StructureError("frames must be finite (F, N, 3) positions of the skeleton's nodes")
     ends = np.zeros(n, dtype=bool) if end_site is None else np.asarray(end_site, dtype=bool)
-    return _Mapper(names, parents, pos, ends).run()
+    return _Mapper(names, parents, pos, ends, armature and frames is None).run()
 
 
 class _Mapper:
-    def __init__(self, names, parents, pos, ends):
+    def __init__(self, names, parents, pos, ends, armature=False):
         self.names, self.parents, self.pos, self.ends = names, parents, pos, ends
+        self.armature = armature
+        self.short = SHORT_REST if armature else SHORT
         n = len(names)
         self.kids: list[list[int]] = [[] for _ in range(n)]
         for j, p in enumerate(parents):
@@ -169,7 +175,15 @@ class _Mapper:
         return max(pairs, key=lambda p: min(size[p[0]], size[p[1]]))
 
     def _branches(self, j: int, frac: float) -> list[int]:
-        return [c for c in self.kids[j] if self.bulk[c] + self.long[c] >= frac * self.size]
+        """Children of j reaching at least frac of the figure; in an armature, a zero-length child's own
+        branches count in its place (Daz's legs hang from a pelvis bone that starts where the hip bone does)."""
+        out = []
+        for c in self.kids[j]:
+            if self.armature and self.kids[c] and self.seg[c] < self.short * self.size:
+                out += self._branches(c, frac)
+            elif self.bulk[c] + self.long[c] >= frac * self.size:
+                out.append(c)
+        return out
 
     def _descend_to_fork(self, j: int, frac: float, forks: int, long: float = 0.0) -> int | None:
         """Follow single big branches down from j to the first node with `forks` or more big branches, two of
@@ -211,7 +225,7 @@ class _Mapper:
         kept = [chain[0]]
         for i, j in enumerate(chain[1:], start=1):
             last = i == len(chain) - 1
-            if self._dist(kept[-1], j) < SHORT * self.size:
+            if self._dist(kept[-1], j) < self.short * self.size:
                 if last and len(kept) > 1:
                     continue  # a zero-length end: the chain really ends at the node before
                 if not last:
@@ -230,10 +244,15 @@ class _Mapper:
         k = self._joints(chain)
         if len(k) < 4:
             raise StructureError(f"the leg from {self.names[branch]!r} has fewer than three joints")
-        seg = [self._dist(k[i], k[i + 1]) for i in range(len(k) - 1)]
-        i = max(range(len(seg) - 1), key=lambda s: seg[s] + seg[s + 1])  # thigh + shin: the longest pair
-        i = max(i, 1)
-        leg = {"Hip": k[i], "Knee": k[i + 1], "Ankle": k[i + 2], "Foot": k[i + 3] if i + 3 < len(k) else None}
+        if self.armature:
+            hip, knee, ankle = rest_leg(self.pos[0], k)
+        else:
+            seg = [self._dist(k[i], k[i + 1]) for i in range(len(k) - 1)]
+            i = max(range(len(seg) - 1), key=lambda s: seg[s] + seg[s + 1])  # thigh + shin: the longest pair
+            hip = max(i, 1)
+            knee, ankle = hip + 1, hip + 2
+        leg = {"Hip": k[hip], "Knee": k[knee], "Ankle": k[ankle],
+               "Foot": k[ankle + 1] if ankle + 1 < len(k) else None}
         leg["feet"] = tuple(j for j in chain[chain.index(leg["Ankle"]):])
         return leg
 
@@ -242,7 +261,14 @@ class _Mapper:
         k = self._joints(chain)
         if len(k) < 4:
             raise StructureError(f"the arm from {self.names[branch]!r} has fewer than three joints")
-        fan = next((j for j in k[3:] if len(self.kids[j]) >= 2), None)
+        arm = self._arm_joints(chain, k)
+        if self.armature and arm["Wrist"] in k:  # twist nodes inside the chain: proportions choose
+            s, e = best_triple(self.pos[0], k, k.index(arm["Wrist"]))
+            arm["Shoulder"], arm["Elbow"] = k[s], k[e]
+        return arm
+
+    def _arm_joints(self, chain: list[int], k: list[int]) -> dict:
+        fan = wrist_fan(self, k)
         if fan is not None:
             w = k.index(fan)
             return {"Shoulder": k[w - 2], "Elbow": k[w - 1], "Wrist": fan,
@@ -373,7 +399,10 @@ class _Mapper:
             roles["Spine"] = RoleMatch(None, (pelvis, chest), f"no spine joint: halfway from pelvis to {nm[chest]}")
         roles["ShoulderCenter"] = RoleMatch(chest, (arm_l["Shoulder"], arm_r["Shoulder"]),
                                             f"between the upper-arm heads; the arms leave the spine at {nm[chest]}")
-        base = next((j for j in reversed(head_chain[1:-1]) if len(self.kids[j]) >= 2), None)
+        if self.armature:  # the head bone: where the face's bones fan out (through zero-length face roots)
+            base = next((j for j in head_chain[1:-1] if fanout(self, j) >= 2), None)
+        else:
+            base = next((j for j in reversed(head_chain[1:-1]) if len(self.kids[j]) >= 2), None)
         if base is None:
             base = head_chain[-2] if len(head_chain) >= 3 else top
         roles["Head"] = RoleMatch(base, (base, top) if base != top else (top,),

@@ -80,13 +80,13 @@ def test_bake_onto_makehuman_skeleton(bpy_empty, shared_data):
 
 # The same real skeleton under other naming conventions: each preset's table must drive its rig.
 RENAMES = {
-    "mixamo": {"root": "mixamorig:Hips", "spine04": "mixamorig:Spine", "spine02": "mixamorig:Spine2",
+    "mixamo": {"root": "mixamorig:Hips", "spine04": "mixamorig:Spine", "spine01": "mixamorig:Spine2",
                "neck01": "mixamorig:Neck", "head": "mixamorig:Head",
                **{f"{mh}.{s}": f"mixamorig:{side}{mx}" for s, side in (("L", "Left"), ("R", "Right"))
                   for mh, mx in (("clavicle", "Shoulder"), ("upperarm01", "Arm"), ("lowerarm01", "ForeArm"),
                                  ("wrist", "Hand"), ("upperleg01", "UpLeg"), ("lowerleg01", "Leg"),
                                  ("foot", "Foot"))}},
-    "hanim": {"root": "sacroiliac", "spine04": "vl5", "spine02": "vt1", "neck01": "vc4", "head": "skullbase",
+    "hanim": {"root": "sacroiliac", "spine04": "vl5", "spine01": "vt1", "neck01": "vc4", "head": "skullbase",
               **{f"{mh}.{s}": f"{s.lower()}_{ha}" for s in ("L", "R")
                  for mh, ha in (("clavicle", "sternoclavicular"), ("upperarm01", "shoulder"),
                                 ("lowerarm01", "elbow"), ("wrist", "wrist"), ("upperleg01", "hip"),

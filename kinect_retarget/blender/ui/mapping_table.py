@@ -8,6 +8,7 @@ from bpy.props import StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 from ...core.presets import build_mapping, load_mapping_file
+from ..io.rig_reader import target_rig_from_object
 from .properties import target_armature
 
 
@@ -58,7 +59,8 @@ class KINECT_RETARGET_OT_mapping_from_preset(bpy.types.Operator):
         s = context.scene.kinect_retarget
         obj = target_armature(context)
         try:
-            used, mapping = build_mapping(s.preset, [b.name for b in obj.data.bones])
+            used, mapping = build_mapping(s.preset, [b.name for b in obj.data.bones], None,
+                                          target_rig_from_object(obj))
         except ValueError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
