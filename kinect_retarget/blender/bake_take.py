@@ -16,6 +16,7 @@ from ..core.kinect_rig_layout import median_segment_lengths
 from ..core.pipeline import BakedMotion, RetargetPipeline, RetargetSettings
 from ..core.presets import build_mapping, mapping_problems
 from ..core.resample import resample_motion
+from ..core.root_motion import apply_root_motion
 from ..core.rotation_modes import channel_values
 from ..core.skeletons import Skeleton
 from ..core.take import Take
@@ -139,6 +140,9 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
     if options.hands == "on" or (options.hands == "auto" and "HandTipLeft" in take.skeleton.joints):
         fingers = apply_hands(motion, hands_on_rig(obj, pipeline.retargeter.mapped), take, take.skeleton.joints,
                               settings.mirror)
+    root_note = ""
+    if options.root_motion:  # after the constrained solve: the keys are final, only the hips change
+        root_note = "; " + apply_root_motion(motion, pipeline.rig, options.root_motion_facing, options.root_bone)
     take_name = whole.metadata.get("name", "take")
     name = action_name or f"{obj.name}_{take_name}"
     reduction = _reduce(obj, motion, options)
@@ -157,7 +161,7 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
                      + (f"; key reduction removed {reduction.removed} keys (max error {reduction.max_deg:.3f}°, "
                         f"{reduction.max_mm:.3f} mm)" if reduction else "")
                      + (f"; left alone (the take has no position for their joints): {', '.join(skipped)}"
-                        if skipped else "") + _reading(take.metadata))
+                        if skipped else "") + root_note + _reading(take.metadata))
     if progress:
         progress(1.0)
     return BakeResult(action, motion, used, (first, last), reduction, strip)

@@ -60,6 +60,12 @@ def add_bake_option_args(p) -> None:
     g.add_argument("--hands", choices=HAND_MODES, default="auto",
                    help="Kinect v2 hands (thumb roll, hand-tip bend, hand-state curls) on rigs with finger bones; "
                         "auto: on for v2 takes")
+    g.add_argument("--root-motion", action="store_true",
+                   help="put the performer's horizontal travel on the rig's root bone, the hips relative to it "
+                        "(game engines; the pose in the world is unchanged)")
+    g.add_argument("--root-motion-facing", action="store_true", help="with --root-motion: the heading too")
+    g.add_argument("--root-bone", help="with --root-motion: the bone to carry it (default: the top ancestor "
+                                       "of the hips bone, e.g. 'root')")
     g.add_argument("--set-scene-fps", action="store_true", help="set the rig file's scene to the key rate")
     g.add_argument("--extend-range", action="store_true",
                    help="grow the rig file's scene range to hold the keys (never shortens it)")
@@ -69,7 +75,9 @@ def bake_options_from_args(args) -> BakeOptions:
     return BakeOptions(range_start=args.take_start, range_end=args.take_end, range_unit=args.range_unit,
                        step=args.step, reduce=args.reduce, tolerance_deg=args.tolerance_deg,
                        tolerance_mm=args.tolerance_mm, into_current=args.into_current, push_nla=args.nla,
-                       set_scene_fps=args.set_scene_fps, extend_scene_range=args.extend_range, hands=args.hands)
+                       set_scene_fps=args.set_scene_fps, extend_scene_range=args.extend_range, hands=args.hands,
+                       root_motion=args.root_motion or args.root_motion_facing,
+                       root_motion_facing=args.root_motion_facing, root_bone=args.root_bone)
 
 
 BVH_FIELDS = {"bvh_unit": "unit", "bvh_standing_height_m": "standing_height_m", "bvh_up_axis": "up_axis",

@@ -27,6 +27,9 @@ class BakeOptions:
     set_scene_fps: bool = False        # run the scene at the bake's rate
     extend_scene_range: bool = False   # grow the scene's frame range to hold the keys (never shrinks it)
     hands: str = "auto"                # thumb roll, hand-tip bend, hand-state curls on rigs with fingers
+    root_motion: bool = False          # the performer's horizontal travel on the rig's root bone (game engines)
+    root_motion_facing: bool = False   # ... and their heading about the up axis
+    root_bone: str | None = None       # the bone to carry it; None = the top ancestor of the hips bone
     keys_on_samples: bool = False      # key each sample at its nearest frame, no resampling (live's recording:
                                        # the baked keys equal the poses live showed)
 

@@ -62,10 +62,11 @@ class TargetRig:
 
 
 def evaluate_pose(rig: TargetRig, bone_indices: np.ndarray, quats: np.ndarray,
-                  root_bone: int | None = None, root_location: np.ndarray | None = None) -> np.ndarray:
+                  root_bone: int | None = None, root_location: np.ndarray | None = None,
+                  locations: dict[int, np.ndarray] | None = None) -> np.ndarray:
     """Forward kinematics like Blender's: posed armature-space matrices (F, B, 4, 4).
 
-    quats (F, M, 4) for the bones `bone_indices`; other bones keep their rest pose. Used by benchmarks and
+    quats (F, M, 4) for the bones `bone_indices`; other bones keep their rest pose; locations {bone: (F, 3)}. Used by benchmarks and
     tests to check the solver without Blender; the bpy tests check Blender itself.
     """
     from .quat import to_matrix
@@ -76,6 +77,8 @@ def evaluate_pose(rig: TargetRig, bone_indices: np.ndarray, quats: np.ndarray,
     basis[:, bone_indices, :3, :3] = to_matrix(quats)
     if root_bone is not None and root_location is not None:
         basis[:, root_bone, :3, 3] = root_location
+    for b, loc in (locations or {}).items():  # other keyed locations (root motion's root bone)
+        basis[:, b, :3, 3] = loc
     posed = np.empty((f, nb, 4, 4))
     for b in parents_first_order(rig):
         p = rig.parents[b]

@@ -109,6 +109,9 @@ def bake_motion(obj: bpy.types.Object, motion: BakedMotion, action_name: str,
         path = f'pose.bones["{escape_identifier(motion.root_bone)}"].location'
         _write_curves(channelbag, path, motion.root_bone, frames, motion.root_location,
                       keys.location_keys if keys is not None else None, into_current)
+    for bone, location in motion.extras.get("locations", {}).items():  # root motion's root bone
+        _write_curves(channelbag, f'pose.bones["{escape_identifier(bone)}"].location', bone, frames, location,
+                      None, into_current)
     for data_path, group, values in extra_curves:
         _write_curves(channelbag, data_path, group, frames[:1], np.reshape(values, (1, -1)), None, into_current)
     ad = obj.animation_data or obj.animation_data_create()

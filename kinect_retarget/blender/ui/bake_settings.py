@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from ...core.bake_options import BakeOptions
 
@@ -46,6 +46,13 @@ class BakeOptionProps:
     destination: EnumProperty(name="Keys Into", items=DESTINATION_ITEMS, default="NEW")
     hands: EnumProperty(name="Hands", items=HAND_ITEMS, default="auto",
                         description="Kinect v2 hands on rigs with finger bones (Rigify, Mixamo, UE Mannequin)")
+    root_motion: BoolProperty(name="Root Motion", default=False,
+                              description="Put the performer's horizontal travel on the rig's root bone, the hips "
+                                          "relative to it (game engines); the pose in the world is unchanged")
+    root_motion_facing: BoolProperty(name="With Facing", default=False,
+                                     description="Root motion carries the performer's heading too")
+    root_bone: StringProperty(name="Root Bone", default="",
+                              description="Bone to carry root motion (empty: the top ancestor of the hips bone)")
 
 
 def options_from(owner) -> BakeOptions:
@@ -56,7 +63,9 @@ def options_from(owner) -> BakeOptions:
                        tolerance_deg=owner.tolerance_deg, tolerance_mm=owner.tolerance_mm,
                        into_current=owner.destination == "CURRENT", push_nla=owner.destination == "NLA",
                        set_scene_fps=owner.set_scene_fps, extend_scene_range=owner.extend_scene_range,
-                       hands=owner.hands)
+                       hands=owner.hands,
+                       root_motion=owner.root_motion, root_motion_facing=owner.root_motion_facing,
+                       root_bone=owner.root_bone or None)
 
 
 def recording_bake_options(scene) -> BakeOptions:
@@ -93,3 +102,9 @@ def draw_bake_options(layout, owner) -> None:
     sub.prop(owner, "tolerance_mm")
     layout.prop(owner, "destination")
     layout.prop(owner, "hands")
+    col = layout.column(heading="Root Motion")
+    col.prop(owner, "root_motion", text="Travel on Root Bone")
+    sub = col.column(align=True)
+    sub.active = owner.root_motion
+    sub.prop(owner, "root_motion_facing")
+    sub.prop(owner, "root_bone")
