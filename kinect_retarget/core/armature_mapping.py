@@ -106,8 +106,10 @@ def structure_mapping_for(bone_names, parents, heads, tails) -> ArmatureMapping:
             out[bone_names[bone]] = joint
             how[joint] = f"{bone_names[bone]} ({why})"
 
-    def path(top: int, below: int) -> list[int]:
+    def path(top: int | None, below: int | None) -> list[int]:
         """Bones from just below `top` down to `below` (inclusive); [] when `below` is not under `top`."""
+        if top is None or below is None:
+            return []
         chain = [below]
         while chain[-1] != top:
             p = int(parents[chain[-1]])
@@ -118,18 +120,18 @@ def structure_mapping_for(bone_names, parents, heads, tails) -> ArmatureMapping:
 
     pelvis, chest, head = role["HipCenter"], role["ShoulderCenter"], role["Head"]
     put(pelvis, "HipCenter", "where the spine and both legs leave")
-    spine = [b for b in path(pelvis, chest)[:-1] if lengths[b] >= SHORT * size] if None not in (pelvis, chest) else []
+    spine = [b for b in path(pelvis, chest)[:-1] if lengths[b] >= SHORT * size]
     if spine:
         put(spine[0], "Spine", "first spine bone of some length above the pelvis")
     if chest not in (None, pelvis):
         put(chest, "ShoulderCenter", "where the arms leave the spine")
-    neck = path(chest, head) if None not in (chest, head) else []
+    neck = path(chest, head)
     if len(neck) > 1:
         put(neck[0], "Neck", "first bone above the chest")
     put(head, "Head", "head bone")
+
     def between(fork: str, joint: str, side: str) -> list[int]:
-        top, end = role.get(fork), role.get(joint + side)
-        return path(top, end)[:-1] if None not in (top, end) else []
+        return path(role.get(fork), role.get(joint + side))[:-1]
 
     for side in ("Left", "Right"):
         for joint, parent in LIMBS:

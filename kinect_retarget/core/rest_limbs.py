@@ -1,4 +1,5 @@
-"""Limb joints of an armature from its rest pose alone (structure_mapping's armature mode).
+"""Joint choices of the structural mapper (structure_mapping.py), chiefly its armature mode: limb joints of
+an armature from its rest pose alone.
 
 A take shows which nodes bend; a rest pose does not, and armatures put twist bones inside their limb chains
 (MakeHuman's upperarm02, Daz's lShldrTwist) where a BVH figure has none. Among the chain's nodes the limb's
@@ -86,3 +87,30 @@ def wrist_fan(m, k: list[int]) -> int | None:
 def fanout(m, j: int) -> int:
     """Children of j, counting those of zero-length children in their place."""
     return sum(fanout(m, c) if m._dist(j, c) < m.short * m.size else 1 for c in m.kids[j])
+
+
+def big_branches(m, j: int, frac: float) -> list[int]:
+    """Children of j reaching at least frac of the figure; in an armature, a zero-length child's own
+    branches count in its place (Daz's legs hang from a pelvis bone that starts where the hip bone does)."""
+    out = []
+    for c in m.kids[j]:
+        if m.armature and m.kids[c] and m.seg[c] < m.short * m.size:
+            out += big_branches(m, c, frac)
+        elif m.bulk[c] + m.long[c] >= frac * m.size:
+            out.append(c)
+    return out
+
+
+def longest_leg(m, k: list[int]) -> tuple[int, int, int]:
+    """(hip, knee, ankle) indices into k for a take's figure: thigh + shin are the longest pair of segments."""
+    seg = [m._dist(k[i], k[i + 1]) for i in range(len(k) - 1)]
+    hip = max(max(range(len(seg) - 1), key=lambda s: seg[s] + seg[s + 1]), 1)
+    return hip, hip + 1, hip + 2
+
+
+def head_base(m, head_chain: list[int]) -> int | None:
+    """The head joint's node: in an armature, the first node where the face's bones fan out (through
+    zero-length face roots); in a take's figure, the last node before the top with two or more children."""
+    if m.armature:
+        return next((j for j in head_chain[1:-1] if fanout(m, j) >= 2), None)
+    return next((j for j in reversed(head_chain[1:-1]) if len(m.kids[j]) >= 2), None)

@@ -16,8 +16,7 @@ API
   forward) and twist nodes are found as the nodes that never bend; without them the rest pose is the only
   frame.
 * ``end_site``: optional (N,) bool, True for nodes that only mark where a chain ends (BVH End Site).
-* ``armature``: True for a rest pose with no take (core/armature_mapping.py): only true zero-length nodes are
-  helpers, and the limbs' joints are chosen among twist nodes inside the chains (core/rest_limbs.py).
+* ``armature``: True for an armature's rest pose (core/armature_mapping.py; its choices: core/rest_limbs.py).
 
 A node is a point: for BVH a joint or end site; for a Blender armature pass every bone's head as a node
 (parent = the parent bone's head node) plus one node for the tail of each bone without children
@@ -39,13 +38,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .floor_plane import estimate_up
-from .rest_limbs import best_triple, fanout, rest_leg, wrist_fan
+from .rest_limbs import best_triple, big_branches, head_base, longest_leg, rest_leg, wrist_fan
 from .skeletons import KINECT_V1
 from .structure_names import kinect_names, name_side
 
 ROLES = KINECT_V1.joints
 SHORT = 0.03        # a segment shorter than this fraction of the figure's size is a zero-length helper
-SHORT_REST = 0.004  # ... in armature mode (an armature's short bones are real: MakeHuman's upperarm01)
+SHORT_REST = 0.004  # ... for an armature (its short bones are real: MakeHuman's upperarm01)
 BIG_BRANCH = 0.15   # a pelvis branch (spine, leg) reaches at least this fraction of the figure's size
 NECK_BRANCH = 0.08  # a chest branch (arm, neck) reaches at least this much
 FINGER = 0.015      # a finger base at least this far from the wrist stands for the hand (not a carpal node)
@@ -111,8 +110,7 @@ def map_structure(names, parents, rest, frames=None, end_site=None, armature=Fal
 class _Mapper:
     def __init__(self, names, parents, pos, ends, armature=False):
         self.names, self.parents, self.pos, self.ends = names, parents, pos, ends
-        self.armature = armature
-        self.short = SHORT_REST if armature else SHORT
+        self.armature, self.short = armature, (SHORT_REST if armature else SHORT)
         n = len(names)
         self.kids: list[list[int]] = [[] for _ in range(n)]
         for j, p in enumerate(parents):
@@ -175,15 +173,7 @@ class _Mapper:
         return max(pairs, key=lambda p: min(size[p[0]], size[p[1]]))
 
     def _branches(self, j: int, frac: float) -> list[int]:
-        """Children of j reaching at least frac of the figure; in an armature, a zero-length child's own
-        branches count in its place (Daz's legs hang from a pelvis bone that starts where the hip bone does)."""
-        out = []
-        for c in self.kids[j]:
-            if self.armature and self.kids[c] and self.seg[c] < self.short * self.size:
-                out += self._branches(c, frac)
-            elif self.bulk[c] + self.long[c] >= frac * self.size:
-                out.append(c)
-        return out
+        return big_branches(self, j, frac)
 
     def _descend_to_fork(self, j: int, frac: float, forks: int, long: float = 0.0) -> int | None:
         """Follow single big branches down from j to the first node with `forks` or more big branches, two of
@@ -244,15 +234,8 @@ class _Mapper:
         k = self._joints(chain)
         if len(k) < 4:
             raise StructureError(f"the leg from {self.names[branch]!r} has fewer than three joints")
-        if self.armature:
-            hip, knee, ankle = rest_leg(self.pos[0], k)
-        else:
-            seg = [self._dist(k[i], k[i + 1]) for i in range(len(k) - 1)]
-            i = max(range(len(seg) - 1), key=lambda s: seg[s] + seg[s + 1])  # thigh + shin: the longest pair
-            hip = max(i, 1)
-            knee, ankle = hip + 1, hip + 2
-        leg = {"Hip": k[hip], "Knee": k[knee], "Ankle": k[ankle],
-               "Foot": k[ankle + 1] if ankle + 1 < len(k) else None}
+        hip, knee, ankle = rest_leg(self.pos[0], k) if self.armature else longest_leg(self, k)
+        leg = {"Hip": k[hip], "Knee": k[knee], "Ankle": k[ankle], "Foot": k[ankle + 1] if ankle + 1 < len(k) else None}
         leg["feet"] = tuple(j for j in chain[chain.index(leg["Ankle"]):])
         return leg
 
@@ -262,9 +245,8 @@ class _Mapper:
         if len(k) < 4:
             raise StructureError(f"the arm from {self.names[branch]!r} has fewer than three joints")
         arm = self._arm_joints(chain, k)
-        if self.armature and arm["Wrist"] in k:  # twist nodes inside the chain: proportions choose
-            s, e = best_triple(self.pos[0], k, k.index(arm["Wrist"]))
-            arm["Shoulder"], arm["Elbow"] = k[s], k[e]
+        if self.armature:  # twist nodes inside the chain: proportions choose the shoulder and elbow
+            arm["Shoulder"], arm["Elbow"] = (k[i] for i in best_triple(self.pos[0], k, k.index(arm["Wrist"])))
         return arm
 
     def _arm_joints(self, chain: list[int], k: list[int]) -> dict:
@@ -399,10 +381,7 @@ class _Mapper:
             roles["Spine"] = RoleMatch(None, (pelvis, chest), f"no spine joint: halfway from pelvis to {nm[chest]}")
         roles["ShoulderCenter"] = RoleMatch(chest, (arm_l["Shoulder"], arm_r["Shoulder"]),
                                             f"between the upper-arm heads; the arms leave the spine at {nm[chest]}")
-        if self.armature:  # the head bone: where the face's bones fan out (through zero-length face roots)
-            base = next((j for j in head_chain[1:-1] if fanout(self, j) >= 2), None)
-        else:
-            base = next((j for j in reversed(head_chain[1:-1]) if len(self.kids[j]) >= 2), None)
+        base = head_base(self, head_chain)
         if base is None:
             base = head_chain[-2] if len(head_chain) >= 3 else top
         roles["Head"] = RoleMatch(base, (base, top) if base != top else (top,),

@@ -66,8 +66,9 @@ def evaluate_pose(rig: TargetRig, bone_indices: np.ndarray, quats: np.ndarray,
                   locations: dict[int, np.ndarray] | None = None) -> np.ndarray:
     """Forward kinematics like Blender's: posed armature-space matrices (F, B, 4, 4).
 
-    quats (F, M, 4) for the bones `bone_indices`; other bones keep their rest pose; locations {bone: (F, 3)}. Used by benchmarks and
-    tests to check the solver without Blender; the bpy tests check Blender itself.
+    quats (F, M, 4) for the bones `bone_indices`; other bones keep their rest pose; locations {bone: (F, 3)}:
+    other keyed locations. Used by benchmarks and tests to check the solver without Blender; the bpy tests
+    check Blender itself.
     """
     from .quat import to_matrix
 

@@ -3,7 +3,6 @@ a short layout per rig family: bone-name lists placed on one body's landmarks. V
 inside the limbs, fingers, face bones, an A-pose, and every name replaced by a seeded random string."""
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, replace
 
 import numpy as np
