@@ -134,7 +134,7 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
     if has_constrained_ancestry(obj, motion.bone_names):
         n = len(motion.frames)
         model = solve_baked(obj, pipeline.rig, motion, {name: 1.0 for _, name, _ in extra},
-                            (lambda f: progress(0.3 + 0.6 * f / n)) if progress else None)
+                            (lambda f: progress(0.3 + 0.6 * f / n)) if progress else None, options.into_current)
         report({"INFO"}, constrained_summary(model))
     fingers = []
     if options.hands == "on" or (options.hands == "auto" and "HandTipLeft" in take.skeleton.joints):

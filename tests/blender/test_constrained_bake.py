@@ -84,3 +84,38 @@ def test_unlearnable_constraints_bake_exactly_through_the_fallback(bpy_empty):
     assert after[:3] == before[:3] and after[4] == before[4]
     errs = _evaluated_error(bpy, obj, res.motion)
     assert errs.max() < 0.001, errs.max()
+
+
+def test_bake_into_the_current_action_keeps_its_other_channels_playing(bpy_empty):
+    """A follow property keyed in the rig's own Action still plays after a bake into that Action, so the
+    probe's copy plays it too: the relation changes over the take, falls back, and the bake is exact."""
+    from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
+    from kinect_retarget.core.bake_options import BakeOptions
+    bpy = bpy_empty
+    take = load_take(SAMPLES / "kinect_v2_ges03_drawlines.krtake").slice(slice(0, 45))
+    obj = new_generated_rig(bpy.context.scene, take)
+    bpy.context.view_layer.objects.active = obj
+    bpy.ops.object.mode_set(mode="EDIT")
+    eb = obj.data.edit_bones
+    b = eb.new("MCH-knee")
+    b.head, b.tail, b.roll, b.parent = eb["KneeLeft"].head, eb["KneeLeft"].tail, eb["KneeLeft"].roll, eb["HipLeft"]
+    eb["KneeLeft"].parent = b
+    bpy.ops.object.mode_set(mode="OBJECT")
+    rot = obj.pose.bones["MCH-knee"].constraints.new("COPY_ROTATION")
+    rot.target, rot.subtarget = obj, "SpineBase"
+    fc = rot.driver_add("influence")
+    var = fc.driver.variables.new()
+    var.type, var.targets[0].id_type, var.targets[0].id = "SINGLE_PROP", "OBJECT", obj
+    var.targets[0].data_path = '["follow"]'
+    fc.driver.expression = var.name
+    obj["follow"] = 0.0
+    obj.keyframe_insert('["follow"]', frame=1)
+    obj["follow"] = 1.0
+    obj.keyframe_insert('["follow"]', frame=40)
+    action = obj.animation_data.action
+    res = bake_take(obj, take, preset="kinect", settings=RetargetSettings(filter="none", fps=30.0),
+                    options=BakeOptions(into_current=True))
+    assert obj.animation_data.action == action and action.name in bpy.data.actions
+    assert len(bpy.data.actions) == 1   # the probe's copy of the Action is gone
+    assert res.motion.extras["parent_model"].fallback_names == ["MCH-knee"]
+    assert _evaluated_error(bpy, obj, res.motion).max() < 0.001

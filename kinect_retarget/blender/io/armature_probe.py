@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
+from bpy.utils import escape_identifier
+from bpy_extras import anim_utils
 
 from ...core.parent_fit import learn, relative_to_parent
 from ...core.parent_model import ParentModel
@@ -47,17 +49,22 @@ def read_rotations(pose_bones, index, flat: np.ndarray, prop: str = "matrix") ->
 
 class ArmatureEvaluator:
     """A temporary scene holding a copy of `obj` (object and Armature data) and nothing else; removed by
-    close() (a context manager). switches: pose bone -> value for its 'IK_FK' property on the copy (what the bake keys)."""
+    close() (a context manager). switches: pose bone -> value for its 'IK_FK' property on the copy (what the
+    bake keys); keyed: (bones, root bone) a bake into the rig's current Action keys (see _play_the_rest)."""
 
-    def __init__(self, obj: bpy.types.Object, bone_order, switches: dict[str, float] | None = None):
+    def __init__(self, obj: bpy.types.Object, bone_order, switches: dict[str, float] | None = None,
+                 keyed: tuple[tuple[str, ...], str | None] | None = None):
         self.source_name = obj.name
         self.scene = bpy.data.scenes.new(f"kinect_retarget_probe_{obj.name}")
         self.copy = obj.copy()  # a pose of its own
         # the bones too: the Armature's own drivers (Rigify's B-Bone eases) read the object, and through
         # them the user's rig would be evaluated (and written back) with the copy
         self.copy.data = obj.data.copy()
+        self.action = None
         if self.copy.animation_data is not None:
             self.copy.animation_data.action = None  # keys would overwrite the poses set here; drivers stay
+            if keyed is not None:
+                self._play_the_rest(obj, keyed, switches or {})
         self._retarget(obj)
         for name, value in (switches or {}).items():
             self.copy.pose.bones[name]["IK_FK"] = value
@@ -69,6 +76,27 @@ class ArmatureEvaluator:
         where = {n: i for i, n in enumerate(pose_names)}
         self.index = np.array([where[n] for n in bone_order])   # rig order -> pose bone order
         self.flat = np.empty(len(pose_names) * 16, dtype=np.float32)
+
+    def _play_the_rest(self, obj, keyed, switches) -> None:
+        """A bake into the Action the rig plays keeps its other channels (a follow property keyed over the
+        take, say): the copy plays a copy of it without the channels the bake keys."""
+        ad = obj.animation_data
+        if ad.action is None or ad.action_slot is None:
+            return
+        self.action = ad.action.copy()
+        slot = next(sl for sl in self.action.slots if sl.identifier == ad.action_slot.identifier)
+        channelbag = anim_utils.action_get_channelbag_for_slot(self.action, slot)
+        names, root = keyed
+        owned = {f'pose.bones["{escape_identifier(b)}"]' for b in names}
+        switched = {f'pose.bones["{escape_identifier(b)}"]["IK_FK"]' for b in switches}
+        root_path = f'pose.bones["{escape_identifier(root)}"].location' if root else None
+        for fc in list(channelbag.fcurves) if channelbag is not None else ():
+            bone, _, prop = fc.data_path.rpartition(".")
+            if fc.data_path in switched or fc.data_path == root_path or \
+                    (bone in owned and prop.startswith("rotation_")):
+                channelbag.fcurves.remove(fc)
+        self.copy.animation_data.action = self.action
+        self.copy.animation_data.action_slot = slot
 
     def _retarget(self, obj) -> None:
         """Constraints and drivers of the copy that read the original read the copy instead."""
@@ -91,6 +119,8 @@ class ArmatureEvaluator:
             data = self.copy.data
             bpy.data.objects.remove(self.copy)
             bpy.data.armatures.remove(data)
+            if self.action is not None:
+                bpy.data.actions.remove(self.action)
             bpy.data.scenes.remove(self.scene)
             self.copy = self.scene = None
 
@@ -210,10 +240,12 @@ def solve_frames(evaluator: ArmatureEvaluator | None, model: ParentModel, desire
 
 
 def solve_baked(obj: bpy.types.Object, rig: TargetRig, motion, switches: dict[str, float] | None = None,
-                progress=None) -> ParentModel:
+                progress=None, into_current: bool = False) -> ParentModel:
     """The bake on a rig with constrained parents: probe, then motion.quats from motion.extras['desired']
-    (the model also lands in motion.extras['parent_model']). The user's scene and rig stay as they were."""
-    with ArmatureEvaluator(obj, rig.bone_names, switches) as evaluator:
+    (the model also lands in motion.extras['parent_model']). The user's scene and rig stay as they were.
+    into_current: the keys go into the Action the rig plays, whose other channels then still play."""
+    keyed = (tuple(motion.bone_names), motion.root_bone) if into_current else None
+    with ArmatureEvaluator(obj, rig.bone_names, switches, keyed) as evaluator:
         model = probe_parents(evaluator, obj, rig, motion.bone_names, motion.root_bone, motion.frames)
         motion.quats = solve_frames(evaluator, model, motion.extras["desired"], motion.root_bone,
                                     motion.root_location, motion.frames, progress)
