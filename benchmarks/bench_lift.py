@@ -2,7 +2,9 @@
 
 Run: .venv/bin/python benchmarks/bench_lift.py [--quick]
 Prints, per take and viewpoint: MPJPE after Procrustes (rigid + scale), root-relative MPJPE, absolute MPJPE,
-and the fraction of frames with a depth-sign flip on any limb, for our lifter and for the paper's method.
+and the fraction of frames with a depth-sign flip on any limb, for our lifter and for the paper's method
+alone (`LiftSettings(method="paper")`, lift/paper_lift.py: eq. 3 scale, orthographic, plain depth with
+continuity signs, no smoothing); the paper's row uses none of our steps.
 """
 from __future__ import annotations
 
@@ -40,7 +42,7 @@ METHODS = {
     "ours (viterbi, persp.)": dict(signs="viterbi", scale="envelope", focal=True),
     "ours, focal unknown": dict(signs="viterbi", scale="envelope", focal=False),
     "ours, causal (greedy)": dict(signs="greedy", scale="envelope", focal=True),
-    "paper (eq.3, ortho)": dict(signs="greedy", scale="paper", focal=False),
+    "paper as published": dict(method="paper", signs="continuity", scale="paper", focal=False),
 }
 
 
@@ -57,7 +59,7 @@ def mocap_take(path: Path, rate: float = 30.0, max_s: float | None = None) -> Ta
 def evaluate(truth: np.ndarray, tracks: Tracks2D, size: dict, method: dict) -> dict:
     """size: LiftSettings' dict(lengths=calibrated (J,) metres) or dict(height_m=...) (anthropometric)."""
     st = LiftSettings(**size, focal_px=FOCAL if method["focal"] else None,
-                      signs=method["signs"], scale=method["scale"])
+                      signs=method["signs"], scale=method["scale"], method=method.get("method", "ours"))
     t0 = time.perf_counter()
     res = lift(tracks, st)
     dt = time.perf_counter() - t0
@@ -111,11 +113,11 @@ def bench_kinectron(noise_px: float = 0.0) -> None:
     v1 = Take(KINECT_V1, truth, take.states[:, idx], take.times, take.rate)
     for label, size in (("calibrated lengths", dict(lengths=lengths_from_take(v1))),
                         ("height 1.70 m (anthropometric)", dict(height_m=1.70))):
-        for focal in (1062.0, None):
-            res = lift(tracks, LiftSettings(**size, focal_px=focal, principal_point=principal))
+        for focal, method in ((1062.0, "ours"), (None, "ours"), (None, "paper")):
+            res = lift(tracks, LiftSettings(**size, focal_px=focal, principal_point=principal, method=method))
             pred = res.take.positions
             m = ok.all(axis=1)
-            print(f"  kinectron, {label}, focal {'1062 px' if focal else 'unknown'}: PA-MPJPE "
+            print(f"  kinectron, {method}, {label}, focal {'1062 px' if focal else 'unknown'}: PA-MPJPE "
                   f"{1000 * mpjpe(procrustes_align(pred[m], truth[m]), truth[m]):.0f} mm, root-rel "
                   f"{1000 * mpjpe(root_relative(pred[m]), root_relative(truth[m])):.0f} mm, absolute "
                   f"{1000 * mpjpe(pred[m], truth[m]):.0f} mm, limb sign-flip frames "

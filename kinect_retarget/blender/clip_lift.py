@@ -18,6 +18,7 @@ from ..lift import LiftError, LiftSettings, lift
 from ..lift.clip_tracks import NamedTrack, tracks_from_named
 from ..lift.tracks2d import Tracks2D
 
+NEW_HANIM = "__NEW_HANIM__"
 NEW_RIG = "__new__"
 
 
@@ -86,7 +87,9 @@ def load_image_rgb(path: str) -> np.ndarray:
 
 
 def _armature_items(self, context):
-    items = [(NEW_RIG, "New Kinect Rig", "Generate an armature matching the lifted skeleton")]
+    items = [(NEW_RIG, "New Kinect Rig", "Generate an armature matching the lifted skeleton"),
+             (NEW_HANIM, "New H-Anim Figure (paper)", "Paper 004's output: a 16-joint H-Anim armature keyed "
+                                                     "with Euler angles from its inverse kinematics")]
     items += [(o.name, o.name, "Bake onto this armature") for o in context.scene.objects if o.type == "ARMATURE"]
     return items
 
@@ -107,6 +110,11 @@ class KINECT_RETARGET_OT_lift_clip(bpy.types.Operator):
     use_clip_camera: BoolProperty(name="Use Clip Camera", default=True,
                                   description="Perspective lifting with the clip's focal length (turn off "
                                               "when the camera settings were never set)")
+    method: EnumProperty(name="Method", default="ours", items=[
+        ("ours", "Ours", "Perspective when the clip's camera is known, smoothed, depth signs over the whole take"),
+        ("paper", "Paper (as published)", "Paper 004: scaled orthographic camera, eq. 3 scale, plain depth "
+                                          "with signs by continuity, no smoothing (Depth Choice and the "
+                                          "clip camera are not used)")])
     signs: EnumProperty(name="Depth Choice", default="viterbi", items=[
         ("viterbi", "Whole Take", "Choose limb depths over the whole take (best)"),
         ("greedy", "Frame by Frame", "Choose limb depths causally, frame after frame"),
@@ -132,7 +140,7 @@ class KINECT_RETARGET_OT_lift_clip(bpy.types.Operator):
         try:
             result = lift_clip_and_bake(context, clip, self.armature, self.preset, self.height,
                                         self.use_clip_camera, self.signs, bpy.path.abspath(self.take_path),
-                                        self.report)
+                                        self.report, method=self.method)
         except (LiftError, TakeError, ValueError) as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
@@ -145,14 +153,15 @@ def _active_clip(context):
 
 def lift_clip_and_bake(context, clip, armature: str, preset: str = "auto", height: float = 1.70,
                        use_clip_camera: bool = True, signs: str = "viterbi", take_path: str = "",
-                       report=lambda level, msg: None):
-    """The operator's work, callable from scripts. Returns the BakeResult."""
+                       report=lambda level, msg: None, method: str = "ours"):
+    """The operator's work, callable from scripts. Returns the BakeResult (the H-Anim armature object
+    for armature=NEW_HANIM)."""
     from ..takes import krtake
     from .bake_take import bake_take, new_generated_rig
 
     tracks = tracks_from_clip(clip, context.scene)
     focal = clip_focal_px(clip) if use_clip_camera else None
-    res = lift(tracks, LiftSettings(height_m=height, focal_px=focal, signs=signs))
+    res = lift(tracks, LiftSettings(height_m=height, focal_px=focal, signs=signs, method=method))
     res.take.metadata["name"] = clip.name
     for msg in res.problems[:5]:
         report({"WARNING"}, msg)
@@ -162,6 +171,13 @@ def lift_clip_and_bake(context, clip, armature: str, preset: str = "auto", heigh
             print(f"kinect_retarget: {msg}")
     if take_path:
         krtake.write(take_path, res.take)
+    if armature == NEW_HANIM:
+        from .io.hanim_figure import build_hanim_figure
+        first = int(tracks.frame_numbers[0]) + clip.frame_start - 1
+        obj = build_hanim_figure(context, res.take, f"{clip.name}_HAnim", frame_start=first)
+        report({"INFO"}, f"Lifted {res.take.frame_count} frames of clip '{clip.name}' ({method}) onto the "
+                         f"H-Anim figure {obj.name}")
+        return obj
     if armature == NEW_RIG or armature not in context.scene.objects:
         obj = new_generated_rig(context.scene, res.take, f"{clip.name}_Rig")
     else:

@@ -21,6 +21,11 @@ def add_parsers(sub) -> None:
     p.add_argument("--clip", help="Movie Clip name in the .blend (default: the only clip)")
     p.add_argument("--signs", choices=("viterbi", "greedy", "camera"), default="viterbi",
                    help="depth-sign choice: whole take (viterbi), causal (greedy), or none (camera)")
+    p.add_argument("--method", choices=("ours", "paper"), default="ours",
+                   help="ours (default), or paper 004 as published: scaled orthographic camera, eq. 3 scale, "
+                        "dz = +-sqrt(L^2 - d^2/s^2) with signs by continuity, no smoothing (docs/lifting.md)")
+    p.add_argument("--hanim", metavar="BLEND", help="also write a .blend holding the paper's output: a "
+                                                    "16-joint H-Anim armature keyed with IK Euler angles")
     p.set_defaults(handler=run_lift)
 
     p = sub.add_parser("track-2d", help="track joints through an image sequence (paper 004 §2): particle "
@@ -35,6 +40,13 @@ def add_parsers(sub) -> None:
 
 
 def run_lift(args) -> int:
+    if args.method == "paper" and args.signs != "viterbi":
+        raise ValueError("--signs chooses among our sign solvers; --method paper has its own (continuity)")
+    if args.method == "paper" and args.focal is not None:
+        raise ValueError("--focal: --method paper uses the scaled orthographic camera of the paper (eq. 1), "
+                         "which has no focal length")
+    if args.hanim and not args.hanim.lower().endswith(".blend"):
+        raise ValueError(f"--hanim {args.hanim}: the output must be a .blend file")
     from ..lift import LiftSettings, detect_2d_format, lift, read_2d
     from ..lift.bones import DEFAULT_HEIGHT_M, lengths_from_take, lengths_scaled_to_height
     from ..takes import krtake, load_take
@@ -54,14 +66,18 @@ def run_lift(args) -> int:
         if args.height is not None:  # an explicit height rescales the calibrated proportions
             lengths = lengths_scaled_to_height(lengths, args.height)
     res = lift(tracks, LiftSettings(height_m=args.height or DEFAULT_HEIGHT_M, lengths=lengths, focal_px=focal,
-                                    image_size=size, signs=args.signs))
+                                    image_size=size, signs=args.signs, method=args.method))
     res.take.metadata["name"] = os.path.splitext(os.path.basename(os.path.normpath(args.out)))[0]
     krtake.write(args.out, res.take)
     for msg in res.problems:
         print(f"warning: {msg}", file=sys.stderr)
-    print(json.dumps({"out": args.out, "frames": res.take.frame_count, "rate": res.take.rate,
-                      "frames_with_body": int(res.take.any_tracked.sum()), "focal_px": res.camera.focal_px,
-                      "focal_known": res.camera.focal_known, "problems": len(res.problems)}))
+    summary = {"out": args.out, "method": args.method, "frames": res.take.frame_count, "rate": res.take.rate,
+               "frames_with_body": int(res.take.any_tracked.sum()), "focal_px": res.camera.focal_px,
+               "focal_known": res.camera.focal_known, "problems": len(res.problems)}
+    if args.hanim:
+        from ..blender.io.hanim_figure import hanim_to_file
+        summary.update(hanim_to_file(res.take, args.hanim))
+    print(json.dumps(summary))
     return 0
 
 

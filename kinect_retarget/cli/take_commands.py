@@ -1,6 +1,7 @@
 """`info` and `bake`: inspect a take, bake it onto a rig and save a .blend."""
 from __future__ import annotations
 
+import argparse
 import json
 import os
 
@@ -37,6 +38,10 @@ def add_parsers(sub) -> None:
                                             "rate in the new scene made without --rig)")
     p.add_argument("--frame-start", type=int, default=1, help="scene frame of the take's (range's) start")
     p.add_argument("--mirror", action="store_true", help="swap the performer's left and right")
+    p.add_argument("--root-scale", type=_root_scale, default=None, metavar="N|auto",
+                   help="paper 000 eq. 13: the factor from the performer's root travel (metres) to the rig's "
+                        "(rig units); 'auto' (default): the rig's leg length over the performer's (1 on a "
+                        "generated rig)")
     p.add_argument("--scale", type=float, help="BVH only: metres per file unit (default: guessed from the "
                                                "figure's standing height)")
     add_bake_option_args(p)
@@ -130,6 +135,19 @@ def run_info(args) -> int:
     return 0
 
 
+def _root_scale(text: str) -> float | None:
+    """'auto' -> None (the leg-length ratio), else a positive number."""
+    if text.strip().lower() == "auto":
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a positive number or 'auto'") from None
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"{text!r}: the root scale must be a positive number")
+    return value
+
+
 def run_bake(args) -> int:
     from ..core.pipeline import RetargetSettings
     from ..core.presets import load_mapping_file
@@ -137,7 +155,7 @@ def run_bake(args) -> int:
     take = load_take(args.take, scale=args.scale)  # bad input fails here, before Blender starts
     take.metadata.setdefault("name", os.path.splitext(os.path.basename(args.take))[0])
     settings = RetargetSettings(filter=args.filter, root_mode=args.root, fps=args.fps,
-                                frame_start=args.frame_start, mirror=args.mirror)
+                                frame_start=args.frame_start, mirror=args.mirror, root_scale=args.root_scale)
     options = bake_options_from_args(args)  # bad options fail here too
     overrides = load_mapping_file(args.mapping) if args.mapping else None
     from ..blender.headless import bake_to_file

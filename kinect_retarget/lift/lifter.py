@@ -23,6 +23,7 @@ from .geometry import JointLines
 from .scale import SCALE_BONES, fill_missing, smooth_lengths, scale_envelope, scale_lower_bound, scale_paper
 from .smoothing import gaussian_kernel, gaussian_smooth
 from .signs import SignPriors, choose_signs
+from .paper_lift import METHODS, continuity_signs, paper_settings
 from .tracks2d import LiftError, Tracks2D
 
 SK = KINECT_V1
@@ -45,7 +46,11 @@ class LiftSettings:
     """height_m sets anthropometric bone lengths unless `lengths` (J,) are given (calibrated, metres).
     focal_px: the camera's focal length in pixels; None means unknown (scaled orthographic model).
     image_size: (W, H) overriding the tracks' own. scale: "envelope" or "paper" (eq. 3). signs: "viterbi",
-    "greedy" or "camera" (signs.py). max_gap_s: longest 2D gap filled by interpolation."""
+    "greedy" or "camera" (signs.py), or "continuity" (paper_lift.py). max_gap_s: longest 2D gap filled by
+    interpolation. method "paper" runs paper 004 as published (paper_lift.py), overriding the camera,
+    scale, signs and every smoothing below; "ours" (default) uses them as set."""
+
+    method: str = "ours"
 
     height_m: float = DEFAULT_HEIGHT_M
     lengths: np.ndarray | None = None
@@ -80,6 +85,10 @@ def lift(tracks: Tracks2D, settings: LiftSettings | None = None, *, scale: np.nd
 
     scale (F,) px/m and signs (F, J) override the estimates (evaluation with known ground truth)."""
     st = settings or LiftSettings()
+    if st.method not in METHODS:
+        raise LiftError(f"unknown lifting method {st.method!r} ({', '.join(METHODS)})")
+    if st.method == "paper":
+        st = paper_settings(st)
     if st.scale not in ("paper", "envelope"):
         raise LiftError(f"unknown scale method {st.scale!r} (envelope, paper)")
     problems = list(tracks.problems)
@@ -111,7 +120,9 @@ def lift(tracks: Tracks2D, settings: LiftSettings | None = None, *, scale: np.nd
     lines = JointLines.build(uv, cam, z_root, st.focal_px is not None, sigma_px)
     r = SK.root
     root = lines.origin[:, r] + lines.direction[:, r] * (z_root / lines.direction[:, r, 2])[:, None]
-    if signs is None:
+    if signs is None and st.signs == "continuity":
+        signs = continuity_signs(lines, lengths, root, body, ORDER)
+    elif signs is None:
         travel = _travel_direction(root, tracks.times, body)
         signs = choose_signs(lines, lengths, root, tracks.times, body, travel, st.priors, st.signs)
     positions = _place_joints(lines, root, have, body, signs, lengths, tracks.times, st.smooth_depth_s)
@@ -119,7 +130,7 @@ def lift(tracks: Tracks2D, settings: LiftSettings | None = None, *, scale: np.nd
     states[~body] = NOT_TRACKED
     positions[~body] = np.nan
     meta = {"lifted_from": tracks.source, "focal_px": cam.focal_px, "focal_known": cam.focal_known,
-            "scale_method": st.scale, "sign_method": st.signs, "noise_px": round(noise_px, 3),
+            "method": st.method, "scale_method": st.scale, "sign_method": st.signs, "noise_px": round(noise_px, 3),
             "problems": len(problems)}
     take = Take(SK, positions, states, tracks.times, nominal_rate(tracks.times), "lift", meta)
     return LiftResult(take, s, signs, cam, problems)

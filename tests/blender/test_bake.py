@@ -263,3 +263,28 @@ def test_operator_uses_the_sidebar_target_and_mapping_table(registered, shared_d
     paths = {fc.data_path for fc in anim_utils.animdata_get_channelbag_for_assigned_slot(target.animation_data).fcurves}
     assert 'pose.bones["ElbowLeft"].rotation_quaternion' not in paths
     assert 'pose.bones["WristLeft"].rotation_quaternion' in paths
+
+
+def test_root_scale_from_the_operator_and_the_cli(registered, shared_data, tmp_path):
+    """Paper 000 eq. 13's n: 0 = auto (1 on a generated rig); 2 doubles the root's travel. The CLI takes a
+    number or 'auto' and refuses anything else before Blender starts."""
+    from kinect_retarget.blender.bake_take import new_generated_rig
+    from kinect_retarget.cli import main
+    bpy = registered
+    take_path = shared_data / "kinect_v2" / "Ges05_demopoint.csv"
+    travel = {}
+    for n in (0.0, 2.0):
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        obj = new_generated_rig(bpy.context.scene, load_take(take_path))
+        bpy.context.view_layer.objects.active = obj
+        assert bpy.ops.kinect_retarget.bake_take(filepath=str(take_path), preset="kinect", filter="none",
+                                                 root_scale=n) == {"FINISHED"}
+        curves = [fc for fc in obj.animation_data.action.layers[0].strips[0].channelbags[0].fcurves
+                  if fc.data_path.endswith(".location")]
+        travel[n] = np.array([[k.co[1] for k in fc.keyframe_points] for fc in curves])
+    np.testing.assert_allclose(travel[2.0], 2 * travel[0.0], atol=1e-5)
+    assert np.abs(travel[0.0]).max() > 0.01
+    with pytest.raises(SystemExit) as stop:  # argparse's usage error
+        main(["bake", str(take_path), "--out", str(tmp_path / "o.blend"), "--root-scale", "-1"])
+    assert stop.value.code == 2
+    assert not (tmp_path / "o.blend").exists()

@@ -211,3 +211,48 @@ def test_joint_tracker_writes_clip_markers(registered, tmp_path, shared_data):
     idx = [KINECT_V1.index(j) for j in names]
     moved = np.linalg.norm(uv[1:, idx] - uv[:1, idx], axis=-1).mean()
     assert moved > 2 * np.mean(errs), (moved, np.mean(errs))  # the joints really moved
+
+
+def test_paper_method_gives_the_keyed_hanim_figure(registered, tmp_path, walk_2d):
+    """Lift Clip with Method = Paper onto 'New H-Anim Figure': 16 H-Anim bones keyed with Euler angles
+    ('XYZ', β = 0); evaluated, every bone points along the lifted take's bone."""
+    bpy = registered
+    from kinect_retarget.blender.clip_lift import NEW_HANIM, lift_clip_and_bake
+    from kinect_retarget.lift import hanim
+    pos, uv = walk_2d
+    clip = _clip(bpy, tmp_path, uv)
+    take_path = tmp_path / "paper.krtake"
+    obj = lift_clip_and_bake(bpy.context, clip, NEW_HANIM, method="paper", take_path=str(take_path))
+    assert [b.name for b in obj.data.bones] == list(hanim.NAMES)
+    assert all(pb.rotation_mode == "XYZ" for pb in obj.pose.bones)
+    curves = obj.animation_data.action.layers[0].strips[0].channelbags[0].fcurves
+    beta = [fc for fc in curves if fc.data_path.endswith("rotation_euler") and fc.array_index == 1]
+    assert len(beta) == 16 and all(abs(k.co[1]) < 1e-9 for fc in beta for k in fc.keyframe_points)
+    from kinect_retarget.takes import load_take
+    take = load_take(take_path)
+    assert take.metadata["method"] == "paper"
+    lifted = kinect_to_blender(take.positions)
+    for f in (0, len(uv) // 2):
+        bpy.context.scene.frame_set(1 + f)
+        for k, name in enumerate(hanim.NAMES):
+            if hanim.TO[k] < 0:
+                continue
+            pb = obj.pose.bones[name]
+            got = np.array(pb.tail) - np.array(pb.head)
+            want = lifted[f, hanim.TO[k]] - lifted[f, hanim.AT[k]]
+            cos = got @ want / np.linalg.norm(got) / np.linalg.norm(want)
+            assert cos > 0.9999, (f, name, cos)
+
+
+def test_cli_lift_paper_writes_the_hanim_blend(bpy_empty, tmp_path, walk_2d):
+    from kinect_retarget.cli import main
+    pos, uv = walk_2d
+    _clip(bpy_empty, tmp_path, uv)
+    blend = tmp_path / "tracked.blend"
+    bpy_empty.ops.wm.save_as_mainfile(filepath=str(blend))
+    out, fig = tmp_path / "walk.krtake", tmp_path / "hanim.blend"
+    assert main(["lift", str(blend), "--format", "clip", "--out", str(out), "--method", "paper",
+                 "--hanim", str(fig)]) == 0
+    assert fig.is_file()
+    assert main(["lift", str(blend), "--format", "clip", "--out", str(out), "--method", "paper",
+                 "--focal", "500"]) == 2  # the paper's camera has no focal length: refused, not ignored

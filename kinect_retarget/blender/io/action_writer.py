@@ -134,3 +134,17 @@ def push_to_nla(obj: bpy.types.Object, name: str, start: int) -> bpy.types.NlaSt
         strip.action_slot = slot
     ad.action = None
     return strip
+
+
+def bake_channels(obj: bpy.types.Object, action_name: str, frames: np.ndarray,
+                  channels: list[tuple[str, str, np.ndarray]]) -> bpy.types.Action:
+    """A new Action for `obj` keyed in bulk with (data_path, group, values (N, C)) channels at `frames`
+    (N,), assigned to it (the Action it had keeps a user)."""
+    action, slot, channelbag = _new_action(obj, action_name)
+    for data_path, group, values in channels:
+        _write_curves(channelbag, data_path, group, np.asarray(frames, np.float32), np.asarray(values))
+    ad = obj.animation_data or obj.animation_data_create()
+    keep_alive(ad.action)
+    ad.action = action
+    ad.action_slot = slot
+    return action

@@ -13,7 +13,7 @@ from ..bake_take import bake_take, take_display_name
 from .bake_settings import BakeOptionProps, copy_options, draw_bake_options, options_from
 from .mapping_table import table_overrides
 from .preferences import FILTER_ITEMS
-from .properties import PRESET_ITEMS, ROOT_ITEMS, target_armature
+from .properties import PRESET_ITEMS, ROOT_ITEMS, ROOT_SCALE_DESC, target_armature
 
 
 class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper, BakeOptionProps):
@@ -32,6 +32,8 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper, BakeOptionP
                        description="Keys per second (0: the scene's rate, or the take's with Set Scene Frame Rate)")
     frame_start: IntProperty(name="Start Frame", default=1, description="Scene frame of the take's (part's) start")
     mirror: BoolProperty(name="Mirror", description="Swap the performer's left and right", default=False)
+    root_scale: FloatProperty(name="Root Scale", default=0.0, min=0.0, soft_max=10.0, precision=3,
+                              description=ROOT_SCALE_DESC)
     scale: FloatProperty(name="BVH Scale", description="BVH only: metres per file unit (0: guess from the "
                          "figure's standing height)", default=0.0, min=0.0, precision=4)
 
@@ -47,6 +49,7 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper, BakeOptionP
         s = getattr(context.scene, "kinect_retarget", None)
         if s is not None:
             self.preset, self.filter, self.root, self.mirror = s.preset, s.filter, s.root, s.mirror
+            self.root_scale = s.root_scale
             copy_options(s, self)
             self.frame_start = context.scene.frame_start
         return super().invoke(context, event)
@@ -55,7 +58,7 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper, BakeOptionP
         layout = self.layout
         layout.use_property_split = True
         layout.use_property_decorate = False
-        for name in ("preset", "mapping_file", "filter", "root", "mirror", "fps", "frame_start"):
+        for name in ("preset", "mapping_file", "filter", "root", "root_scale", "mirror", "fps", "frame_start"):
             layout.prop(self, name)
         draw_bake_options(layout, self)
 
@@ -72,7 +75,8 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper, BakeOptionP
             if self.mapping_file:
                 overrides.update(load_mapping_file(bpy.path.abspath(self.mapping_file)))
             settings = RetargetSettings(filter=self.filter, root_mode=self.root, fps=self.fps or None,
-                                        frame_start=self.frame_start, mirror=self.mirror)
+                                        frame_start=self.frame_start, mirror=self.mirror,
+                                        root_scale=self.root_scale or None)  # 0: auto (leg-length ratio)
             options = options_from(self)
         except (TakeError, ValueError) as exc:
             self.report({"ERROR"}, str(exc))

@@ -148,6 +148,7 @@ class KINECT_RETARGET_PT_options(_KinectPanel, bpy.types.Panel):
         col.enabled = live_runtime.controller() is None
         col.prop(s, "filter")
         col.prop(s, "root")
+        col.prop(s, "root_scale", text="Root Scale (0 = Auto)")
         col.prop(s, "mirror")
         obj = target_armature(context)
         if obj is not None and fallback_bones(obj.name):  # only a rig with bones no relation explains needs it

@@ -41,6 +41,10 @@ class KinectRetargetTake(bpy.types.PropertyGroup):
     date: StringProperty(name="Recorded", description="When the recording stopped (local time)")
 
 
+ROOT_SCALE_DESC = ("Paper 000 eq. 13: factor from the performer's root travel (metres) to the rig's; "
+                   "0 = auto (the rig's leg length over the performer's, 1 on a generated rig)")
+
+
 class KinectRetargetSettings(bpy.types.PropertyGroup, BakeOptionProps):
     initialised: BoolProperty(default=False, options={"HIDDEN"})
     source: EnumProperty(name="Source", items=SOURCE_ITEMS, default="TAKE")
@@ -56,6 +60,8 @@ class KinectRetargetSettings(bpy.types.PropertyGroup, BakeOptionProps):
     filter: EnumProperty(name="Filter", items=FILTER_ITEMS, default="default")
     root: EnumProperty(name="Root Motion", items=ROOT_ITEMS, default="xyz")
     mirror: BoolProperty(name="Mirror", default=False, description="Swap the performer's left and right")
+    root_scale: FloatProperty(name="Root Scale", default=0.0, min=0.0, soft_max=10.0, precision=3,
+                              description=ROOT_SCALE_DESC)
     exact_constrained: BoolProperty(
         name="Exact on Constrained Rigs", default=False,
         description="On rigs with constraint-driven parents no learned relation explains (shown only for "

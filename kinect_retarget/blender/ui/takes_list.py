@@ -76,7 +76,8 @@ class KINECT_RETARGET_OT_take_bake(_TakeOperator, bpy.types.Operator):
         options = {name: getattr(s, name) for name in BakeOptionProps.__annotations__}
         try:
             return bpy.ops.kinect_retarget.bake_take("EXEC_DEFAULT", filepath=path, preset=s.preset, filter=s.filter,
-                                                     root=s.root, mirror=s.mirror, **options)
+                                                     root=s.root, mirror=s.mirror, root_scale=s.root_scale,
+                                                     **options)
         except RuntimeError as exc:
             self.report({"ERROR"}, str(exc).removeprefix("Error: ").strip())
             return {"CANCELLED"}
