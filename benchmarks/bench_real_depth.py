@@ -159,6 +159,8 @@ def main() -> None:
     ap.add_argument("--actions", type=ints, default=set(ACTIONS))
     ap.add_argument("--limit", type=int, help="track only the first N frames of each sequence")
     ap.add_argument("--save", help="directory to write each sequence's tracked positions/states (.npz)")
+    ap.add_argument("--forest", help="body-part forest (.npz) to track with instead of the shipped one; 'none': "
+                    "track without body parts")
     ap.add_argument("--load", help="score positions/states saved by --save instead of tracking")
     args = ap.parse_args()
     if not DATA.is_dir():
@@ -168,6 +170,8 @@ def main() -> None:
     print(f"real-depth benchmark: {len(seqs)} UTD-MHAD sequences (640x480 upsampled, f = {FOCAL_640} px, one "
           f"thread), scored against the Kinect SDK skeleton at the best lag of 0-{MAX_LAG} frames", flush=True)
     settings = TrackerSettings()
+    if args.forest:
+        settings.part_forest = None if args.forest == "none" else args.forest
     rows, lat_all, t0 = [], [], time.perf_counter()
     for a, s, t, path in seqs:
         depth, sdk = load(path)

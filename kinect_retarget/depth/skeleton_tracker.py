@@ -18,6 +18,9 @@ from ..core.take import Take
 from .body_model_fit import BodyCalibration
 from .depth_camera import DepthCamera
 from .confidence import ConfidenceCheck
+from .part_fit import apply_proposals
+from .part_forest import MODEL_PATH, load_forest
+from .part_proposals import propose
 from .segmentation import DepthGrid, FloorPlane, PersonMask, find_people, fit_floor
 from .skeleton_fit import FitResult, fit_person
 
@@ -32,6 +35,7 @@ class TrackerSettings:
     step: int = 4                 # grid stride on the 640x480 image
     smoothing: float = 0.35       # 0 = raw fit; blends toward the previous frame for small moves only
     floor_refit_every: int = 15   # frames between floor fits (the floor does not move)
+    part_forest: str | None = MODEL_PATH   # body-part forest (.npz) whose joint proposals refine the fit; None = off
 
 
 class SkeletonTracker:
@@ -40,6 +44,7 @@ class SkeletonTracker:
         self.gravity: np.ndarray | None = None
         self.settings = settings or TrackerSettings()
         self.skeleton = KINECT_V1
+        self.forest = load_forest(self.settings.part_forest) if self.settings.part_forest else None
         self.reset()
         if gravity is not None:
             self.set_gravity(gravity)   # any scale (an accelerometer reads about 9.8): kept as a unit vector
@@ -59,6 +64,7 @@ class SkeletonTracker:
         self.last_grid: DepthGrid | None = None
         self.last_mask: np.ndarray | None = None
         self.last_good: FitResult | None = None
+        self.last_proposals = None
 
     def set_gravity(self, gravity) -> None:
         """Accelerometer reading (any scale), pointing down in camera space."""
@@ -106,6 +112,9 @@ class SkeletonTracker:
         if fit is None or not np.all(np.isfinite(fit.positions)):
             self._lose(ts)
             return self._none("person found but no skeleton fitted")
+        if self.forest is not None:
+            self.last_proposals = propose(self.forest, grid, person.mask)
+            apply_proposals(fit.positions, fit.states, self.last_proposals, self.calibration.height)
         pos, st = fit.positions, self.confidence.assess(fit.positions, fit.states, fit)
         self._calibrate(person, fit, up)
         if self._prev is not None and self.settings.smoothing > 0:

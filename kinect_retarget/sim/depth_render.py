@@ -38,8 +38,9 @@ def quad_sampler(rest_vertices: np.ndarray, quads: np.ndarray, min_distance: flo
     return groups
 
 
-def splat(points: np.ndarray, cam: DepthCamera) -> np.ndarray:
-    """Z-buffer (H, W) of the nearest point per pixel (inf where empty)."""
+def splat(points: np.ndarray, cam: DepthCamera, values: np.ndarray | None = None):
+    """Z-buffer (H, W) of the nearest point per pixel (inf where empty); with `values` (one per point), also
+    the (H, W) image of the nearest point's value (-1 where empty)."""
     z = points[:, 2]
     ok = z > 0.3
     p = points[ok]
@@ -50,7 +51,11 @@ def splat(points: np.ndarray, cam: DepthCamera) -> np.ndarray:
     order = np.argsort(-z, kind="stable")  # nearest written last wins
     buf = np.full(cam.width * cam.height, np.inf)
     buf[idx[order]] = z[order]
-    return buf.reshape(cam.height, cam.width)
+    if values is None:
+        return buf.reshape(cam.height, cam.width)
+    vals = np.full(cam.width * cam.height, -1, np.int64)
+    vals[idx[order]] = np.asarray(values)[ok][inside][order]
+    return buf.reshape(cam.height, cam.width), vals.reshape(cam.height, cam.width)
 
 
 def fill_pinholes(depth: np.ndarray) -> np.ndarray:

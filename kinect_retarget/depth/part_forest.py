@@ -1,0 +1,81 @@
+"""Per-cell body-part classification by a randomized decision forest over depth-difference features.
+
+Shotton et al. (CVPR 2011): f(x) = d(x + u / d(x)) - d(x + v / d(x)), offsets u, v in metres at the pixel's
+depth so the feature does not change with distance. Here d is the tracker's depth grid (every 4th pixel of
+640x480), with every cell that is not the person read as BACKGROUND_DEPTH. The forest is trained offline
+(tools/train_body_parts.py, on rendered MakeHuman bodies only) and shipped as one .npz of flat arrays;
+inference walks all trees for all cells at once in numpy, one tree level per step.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+BACKGROUND_DEPTH = 10.0   # metres read at a probe off the person or off the image
+# shipped with the package's runtime assets (kinect_retarget/assets, credits and recipe in its CREDITS.md)
+MODEL_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "assets", "body_parts_forest.npz")
+
+
+def probe_features(zb: np.ndarray, rows: np.ndarray, cols: np.ndarray, offsets: np.ndarray, cells_per_m: float):
+    """(N,) or (N, K) feature values at cells (rows, cols) of the person depth grid `zb` (metres,
+    BACKGROUND_DEPTH off the person): offsets (..., 2, 2) = (probe u, probe v) x (right, down) in metres;
+    `cells_per_m` = focal length / grid step (a metre at 1 m spans that many cells)."""
+    h, w = zb.shape
+    z = zb[rows, cols]
+    scale = cells_per_m / z
+    if offsets.ndim == 4:   # a pool of features for every cell: broadcast (N, 1) against (K,)
+        scale, rows, cols = scale[:, None], rows[:, None], cols[:, None]
+    vals = []
+    for k in (0, 1):
+        r = rows + np.rint(offsets[..., k, 1] * scale).astype(np.int64)
+        c = cols + np.rint(offsets[..., k, 0] * scale).astype(np.int64)
+        inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+        vals.append(np.where(inside, zb[np.clip(r, 0, h - 1), np.clip(c, 0, w - 1)], BACKGROUND_DEPTH))
+    return vals[0] - vals[1]
+
+
+@dataclass(frozen=True)
+class PartForest:
+    offsets: np.ndarray     # (K, 2, 2) feature pool, metres
+    feature: np.ndarray     # (nodes,) index into offsets; leaves point at themselves (left = right = node)
+    threshold: np.ndarray   # (nodes,) go left when the feature <= threshold
+    left: np.ndarray        # (nodes,)
+    right: np.ndarray       # (nodes,)
+    leaf_probs: np.ndarray  # (nodes, parts) uint8, probability x 255 (zero rows for split nodes)
+    roots: np.ndarray       # (trees,) node index of each tree's root
+    depth: int              # deepest leaf
+
+    def classify(self, zb: np.ndarray, rows: np.ndarray, cols: np.ndarray, cells_per_m: float) -> np.ndarray:
+        """(N, parts) float32 part probabilities of the cells (rows, cols), averaged over the trees."""
+        t = len(self.roots)
+        node = np.repeat(self.roots[None], len(rows), axis=0).ravel()   # (N * trees,)
+        rr, cc = np.repeat(rows, t), np.repeat(cols, t)
+        for _ in range(self.depth):
+            f = probe_features(zb, rr, cc, self.offsets[self.feature[node]], cells_per_m)
+            node = np.where(f <= self.threshold[node], self.left[node], self.right[node])
+        probs = self.leaf_probs[node].reshape(len(rows), t, -1).astype(np.float32)
+        return probs.mean(axis=1) * (1.0 / 255.0)
+
+    def save(self, path: str, **recipe) -> None:
+        np.savez_compressed(path, offsets=self.offsets.astype(np.float32), feature=self.feature.astype(np.int16),
+                            threshold=self.threshold.astype(np.float32), left=self.left.astype(np.int32),
+                            right=self.right.astype(np.int32), leaf_probs=self.leaf_probs.astype(np.uint8),
+                            roots=self.roots.astype(np.int32), depth=np.int32(self.depth),
+                            recipe=np.array(repr(recipe)))
+
+
+@lru_cache(maxsize=2)
+def load_forest(path: str = MODEL_PATH) -> PartForest | None:
+    """The shipped forest, or None when the file is missing or unreadable (the tracker then works without
+    body parts)."""
+    try:
+        with np.load(path, allow_pickle=False) as d:
+            return PartForest(d["offsets"].astype(np.float64), d["feature"].astype(np.int64),
+                              d["threshold"].astype(np.float64), d["left"].astype(np.int64),
+                              d["right"].astype(np.int64), d["leaf_probs"], d["roots"].astype(np.int64),
+                              int(d["depth"]))
+    except (OSError, KeyError, ValueError):
+        return None

@@ -1,0 +1,64 @@
+"""The shipped body-part forest on a rendered frame, and the per-pixel labels it was trained on."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from kinect_retarget.core.skeletons import KINECT_V1
+from kinect_retarget.depth.body_parts import BACKGROUND, PART, PARTS
+from kinect_retarget.depth.part_forest import MODEL_PATH, load_forest
+from kinect_retarget.depth.part_proposals import propose
+from kinect_retarget.depth.skeleton_tracker import SkeletonTracker, TrackerSettings
+
+
+def test_shipped_forest_classifies_a_rendered_frame(rendered):
+    forest = load_forest(MODEL_PATH)
+    assert forest is not None, f"{MODEL_PATH} is missing or unreadable"
+    assert forest.leaf_probs.shape[1] == len(PARTS) and len(forest.roots) >= 1
+    seq, _ = rendered
+    tracker = SkeletonTracker(gravity=seq.gravity, settings=TrackerSettings(part_forest=None))
+    for f in range(4):
+        tracker.update(seq.mm[f], seq.times[f])
+    props = propose(forest, tracker.last_grid, tracker.last_mask)
+    assert np.allclose(props.probs.sum(axis=1), 1.0, atol=0.05)
+    gt = seq.joints[3]
+    rows, cols = props.cells
+    pts = tracker.last_grid.xyz[rows, cols]
+    label = np.argmax(props.probs, axis=1)
+    near_head = np.linalg.norm(pts - gt[KINECT_V1.index("Head")], axis=1) < 0.12   # the head joint is its centre
+    assert near_head.sum() > 10 and np.mean(label[near_head] == PART["head"]) > 0.6
+    for joint, bound in (("Head", 0.10), ("FootLeft", 0.15), ("FootRight", 0.15)):
+        j = KINECT_V1.index(joint)
+        assert props.confidence[j] > 0, joint
+        assert np.linalg.norm(props.positions[j] - gt[j]) < bound, joint
+
+
+def test_unreadable_forest_leaves_the_tracker_without_parts(tmp_path):
+    bad = tmp_path / "forest.npz"
+    bad.write_bytes(b"not a forest")
+    assert load_forest(str(bad)) is None
+    assert SkeletonTracker(settings=TrackerSettings(part_forest=str(bad))).forest is None
+
+
+def test_part_labels_from_skin_weights(shared_data):
+    from kinect_retarget.depth.depth_camera import DepthCamera
+    from kinect_retarget.sim.body_part_labels import render_parts, surface_labels, vertex_parts
+    from kinect_retarget.sim.depth_render import quad_sampler, surface_points
+    from kinect_retarget.sim.makehuman_body import load_body
+    body = load_body(str(shared_data / "meshes" / "makehuman"))
+    labels = vertex_parts(body)
+    counts = np.bincount(labels, minlength=len(PARTS))
+    assert np.all(counts > 0)   # every part has skin
+    for name in PARTS:
+        if name.endswith("_left") and not name.startswith("torso"):   # symmetric limbs (the midline is one side)
+            assert counts[PART[name]] == counts[PART[name[:-5] + "_right"]], name
+    # the performer's left (MakeHuman +X) is labelled left
+    assert np.all(body.rest_vertices[labels == PART["hand_left"], 0] > 0)
+    cam = DepthCamera()
+    groups = quad_sampler(body.rest_vertices, body.quads, 2.5, cam)
+    v = body.rest_vertices * [-1, 1, -1] + [0, 0, 2.5]   # turned to face the sensor, 2.5 m away
+    depth, image = render_parts(surface_points(v, body.quads, groups), surface_labels(labels, body.quads, groups), cam)
+    seen = image != BACKGROUND
+    assert np.array_equal(seen, np.isfinite(depth))
+    cols = np.nonzero(image == PART["hand_left"])[1]
+    assert len(cols) > 20 and np.all(cols > cam.cx)   # facing the sensor, the left hand is on the image's right
