@@ -49,7 +49,7 @@ def picture(frames: list[np.ndarray]) -> np.ndarray:
                 shifted = np.roll(over, (dr, dc), axis=(0, 1))
                 drawn = np.any(shifted[..., :3] > 0, axis=-1)
                 img[drawn] = shifted[drawn]
-    return (img[..., :3] * 255).astype(np.uint8)
+    return img[..., :3]
 
 
 def main() -> None:

@@ -114,7 +114,8 @@ class SkeletonTracker:
             return self._none("person found but no skeleton fitted")
         if self.forest is not None:
             self.last_proposals = propose(self.forest, grid, person.mask)
-            apply_proposals(fit.positions, fit.states, self.last_proposals, self.calibration.height)
+            apply_proposals(fit.positions, fit.states, self.last_proposals, self.calibration.height,
+                            no_floor=self.floor is None)
         pos, st = fit.positions, self.confidence.assess(fit.positions, fit.states, fit)
         self._calibrate(person, fit, up)
         if self._prev is not None and self.settings.smoothing > 0:
