@@ -17,7 +17,7 @@ from . import body_model_fit as bm
 
 J = KINECT_V1.index
 SIDES = ("Left", "Right")
-USE_CONFIDENCE = 0.0004     # square metres of likely part around a proposal from which it is used
+USE_CONFIDENCE = 0.0006     # square metres of likely part around a proposal from which it is used
 TRACK_CONFIDENCE = 0.0008   # ... and from which its joint is reported tracked
 # What takes proposals. Chosen on the real-depth benchmark's subjects 1-2 under the synthetic benchmark's bound
 # (no regression, no tracked sample beyond 15 cm): head, shoulders and feet taken from proposals measured far
@@ -43,11 +43,11 @@ def _state(c: float) -> int:
     return TRACKED if PROMOTE and c >= TRACK_CONFIDENCE else INFERRED
 
 
-def _usable(conf, p, pos, st, no_floor: bool):
+def _usable(conf, p, pos, st, no_floor: bool, in_view):
     """(20,) bool: confident proposals near their joint of the fit, and not nearer the other side's joint
     (left and right parts confused: taking it would swap the limbs)."""
     move = np.linalg.norm(p - pos, axis=1)
-    ok = (conf >= USE_CONFIDENCE) & (move <= MAX_MOVE)
+    ok = (conf >= USE_CONFIDENCE) & (move <= MAX_MOVE) & in_view
     if ONLY_INFERRED:
         feet = [J(f"{n}{s}") for n in ("Foot", "Ankle") for s in SIDES]
         keep = ok[feet].copy()
@@ -61,12 +61,15 @@ def _usable(conf, p, pos, st, no_floor: bool):
     return ok
 
 
-def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_floor: bool = False) -> None:
+def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_floor: bool = False,
+                    in_view=True) -> None:
     """Move joints to confident proposals, in place (positions (20, 3), states (20,)). `no_floor`: no floor
     was found, so nothing removed what lies below the feet (a pre-segmented frame keeps shadows and floor
-    specks there, where the foot's extremity lands): the feet take their proposals whatever the fit says."""
+    specks there, where the foot's extremity lands): the feet take their proposals whatever the fit says.
+    `in_view` ((20,) bool): joints the fit placed inside the image (one continued past its edge keeps its
+    place: the part seen at the edge is not its end)."""
     conf, p = props.confidence, props.positions
-    use = _usable(conf, p, pos, st, no_floor)
+    use = _usable(conf, p, pos, st, no_floor, in_view)
     before_st = st.copy()
     for name in DIRECT:
         j = J(name)

@@ -114,8 +114,10 @@ class SkeletonTracker:
             return self._none("person found but no skeleton fitted")
         if self.forest is not None:
             self.last_proposals = propose(self.forest, grid, person.mask)
+            rc = grid.to_pixel(fit.positions)   # a limb the fit continued past the image's edge keeps its end
+            in_view = np.all((rc >= 0) & (rc < np.array(grid.z.shape) - 1), axis=1)
             apply_proposals(fit.positions, fit.states, self.last_proposals, self.calibration.height,
-                            no_floor=self.floor is None)
+                            no_floor=self.floor is None, in_view=in_view)
         pos, st = fit.positions, self.confidence.assess(fit.positions, fit.states, fit)
         self._calibrate(person, fit, up)
         if self._prev is not None and self.settings.smoothing > 0:
