@@ -16,18 +16,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.skeletons import INFERRED, NOT_TRACKED, TRACKED
+from ..core.skeletons import INFERRED, TRACKED
 from . import body_model_fit as bm
 from .arm_search import SIDES, J, TorsoFrame, fit_arms
 from .facing import chest_facing
 from .surface_geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
-from .limb_ends import at_image_border, occluded_end
+from .limb_fit import LimbScene, _nearest_cell, fit_limb
 from .sides import assign_sides
-from .two_bone import two_bone_candidates
 from .two_bone import unit as _unit
 
-# weights of the elbow/knee choice on the IK circle (per metre): level-set centroid, previous frame
-W_LEVEL_SET, W_PREVIOUS = 1.0, 0.3
 HEAD_AXIS_WEIGHT = 0.65      # torso axis pulled this far toward the line from the torso patch to the head top
 MAX_SIDE_LEAN_DEG = 20.0    # sideways component of a lean beyond which the "head" is not trusted to tilt
 MAX_LEAN_DEG = 60.0         # a "head" farther than this from upright is taken for something else
@@ -35,14 +32,11 @@ AXIS_GRAVITY_WEIGHT = 0.75  # torso axis = this blend of gravity's up and the to
 SIDE_ON_WIDTH = 0.165       # visible chest width / height below which the torso is taken as seen side-on
 HEAD_REGION = 0.12          # fraction of height along the surface from the head's extremum: head and neck
 ARM_SEARCH = True           # arms without a hand extremity: search poses against the depth (arm_search)
-TRUNCATED_EXTEND = 0.5      # a limb leaving the image continues this fraction of its remaining reach
-W_MIDLINE = 1.0             # per metre a knee lies across the body's midline
 BEHIND_FREE, BEHIND_COST = 0.06, 0.5   # m behind the surface a joint may sit for free; cost per metre beyond
 SUPPORT_BEHIND = 0.08       # m behind the surface seen at its pixel an elbow/knee may sit and still be tracked
 TURNED_DEG = 45.0           # facing estimate turned this far: shoulders and hips overlap in depth, inferred
 SIDE_ON_DEG = 75.0          # chest facing this far from the sensor: side-on, the last facing is kept
 LATERAL_SMOOTHING = 0.5     # weight of the last frame's left-right direction (the chest's estimate is noisy)
-REACH_SLACK = 0.10          # m an extremity may lie beyond the limb's calibrated reach and still be its end
 
 
 @dataclass
@@ -55,14 +49,6 @@ class FitResult:
     projector: "Projector | None" = None          # for the confidence checks after the fit
     edge_on: bool = False                          # the chest's normal was unusable (seen side-on)
     turned: bool = False                           # facing more than TURNED_DEG away from the sensor
-
-
-def _nearest_cell(xyz: np.ndarray, mask: np.ndarray, p: np.ndarray) -> tuple[int, int] | None:
-    if not mask.any():
-        return None
-    d = np.where(mask, np.linalg.norm(xyz[..., :2] - p[:2], axis=-1) + 0.3 * np.abs(xyz[..., 2] - p[2]), np.inf)
-    k = int(np.argmin(d))
-    return divmod(k, mask.shape[1])
 
 
 class Projector:
@@ -117,7 +103,80 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
     graph = SurfaceGraph(xyz, mask, max_jump=0.06)
     proj = Projector(grid, (r0, c0), xyz, mask)
     H = calib.height
-    # --- torso ---------------------------------------------------------------------------------------
+    torso = _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, prev_centre)
+    if torso is None:
+        return None
+    d0, loose, centre, axis, lat, facing, view, edge_on, narrow = torso
+    inside = lambda name: view * bm.DEPTH_INSIDE[name]
+    # --- extremities ---------------------------------------------------------------------------------
+    extrema = geodesic_extrema(loose, d0, count=6, min_distance=0.15 * H, iterations=4)
+    cand = []
+    for r, c, dist in extrema:
+        p = xyz[r, c]
+        cand.append(((r, c), p, dist, (p - centre) @ axis, (p - centre) @ lat))
+    head, shift, centre, axis, lat, facing = _pin_along_axis(xyz, mask, cand, centre, axis, lat, facing, up, calib)
+
+    def along(h_frac: float) -> np.ndarray:
+        return centre + axis * (h_frac - calib.torso_patch_height) * H
+
+    pos = np.zeros((20, 3))
+    st = np.full(20, INFERRED, np.uint8)
+    for name, hf in (("HipCenter", bm.HEIGHT_HIP_CENTER), ("Spine", bm.HEIGHT_SPINE),
+                     ("ShoulderCenter", bm.HEIGHT_SHOULDER_CENTER)):
+        pos[J[name]] = along(hf) + inside(name)
+        st[J[name]] = TRACKED
+    rest = [e for e in cand if e is not head]
+    feet = sorted([e for e in rest if e[3] < -0.33 * H], key=lambda e: -e[2])[:2]
+    hands = sorted([e for e in rest if e not in feet and e[3] > -0.35 * H and e[2] > 0.22 * H],
+                   key=lambda e: -e[2])[:2]
+    labels = []
+    head_region = None
+    if head is not None:
+        dh = graph.distances(np.array([head[0]]), iterations=3)
+        head_region = dh < HEAD_REGION * H
+        hc = level_set_centroid(xyz, dh, 0.06 * H, band(0.04), head[1], 0.2)
+        pos[J["Head"]] = (hc if hc is not None else head[1] - axis * 0.05 * H) + inside("Head")
+        st[J["Head"]] = TRACKED
+        labels.append(("head", head[1]))
+    else:
+        pos[J["Head"]] = pos[J["ShoulderCenter"]] + axis * (bm.HEIGHT_HEAD - bm.HEIGHT_SHOULDER_CENTER) * H
+    sc, hc_ = pos[J["ShoulderCenter"]], pos[J["HipCenter"]]
+    for s, sign in (("Left", 1.0), ("Right", -1.0)):
+        pos[J[f"Shoulder{s}"]] = sc + lat * sign * bm.SHOULDER_HALF_WIDTH * H - axis * bm.SHOULDER_DROP * H
+        pos[J[f"Hip{s}"]] = hc_ + lat * sign * bm.HIP_HALF_WIDTH * H
+        st[J[f"Shoulder{s}"]] = st[J[f"Hip{s}"]] = TRACKED
+    # --- limbs ---------------------------------------------------------------------------------------
+    limb_specs = (("Shoulder", "Elbow", "Wrist", "Hand", bm.UPPER_ARM, bm.FOREARM, hands, 0.08, 0.08 + bm.HAND * H),
+                  ("Hip", "Knee", "Ankle", "Foot", bm.THIGH, bm.SHIN, feet, 0.07, 0.15))
+    legs_clipped = 0
+    scene = LimbScene(grid, r0, c0, xyz, mask, graph, proj, d0, centre, axis, lat, facing, view, H, prev,
+                      prev_states, pos, st, labels, cell)
+    for root, mid, end, tip, r1, r2, found, d_tip, d_end in limb_specs:
+        assign = assign_sides(found, prev if predicted is None else predicted, prev_states, tip)
+        for s in SIDES:
+            legs_clipped += fit_limb(scene, root, mid, end, tip, r1, r2, d_tip, d_end, s, assign.get(s))
+    if ARM_SEARCH:
+        fit_arms(pos, st, xyz, mask, proj, TorsoFrame(centre, axis, lat, facing, pos, H), H, prev, head_region,
+                 settled, facing_steady)
+    # without the head top or the shoulders the torso's place along its axis is a guess; seen more than
+    # TURNED_DEG from the front, shoulders and hips overlap in depth: say so instead of claiming them
+    if shift is None:
+        st[[J["HipCenter"], J["Spine"], J["ShoulderCenter"]]] = INFERRED
+    if legs_clipped == 2:   # both legs leave the image (the SDK's "clipped bottom"): nothing checks the hips
+        st[[J["HipCenter"], J["HipLeft"], J["HipRight"]]] = INFERRED
+    turned = bool(facing @ -view < np.cos(np.radians(TURNED_DEG)))
+    if turned:
+        for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
+            st[J[name]] = INFERRED
+    return FitResult(pos, st, lat, labels, centre, proj, edge_on or narrow, turned)
+
+
+def _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, prev_centre):
+    """The torso: a geodesic disc around the last spine (or the person's middle) gives its centre and long
+    axis; the chest's normals its facing, kept through side-on views. None when the person has no torso.
+    Returns (d0 geodesic distances from the seed, the graph that reached every part, centre, axis, lat,
+    facing, view, edge_on, narrow)."""
+    H = calib.height
     seed_p = prev_centre if prev_centre is not None else grid.xyz[mask_full].mean(axis=0)
     seed = _nearest_cell(xyz, mask, seed_p)
     if seed is None:
@@ -160,13 +219,13 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
     facing = _unit(np.cross(lat, axis))
     # the torso plane's normal always faces the sensor, even side-on; the chest's visible width does not lie
     narrow = _visible_chest_width(xyz[mask], centre, axis, view, H) < SIDE_ON_WIDTH * H
-    inside = lambda name: view * bm.DEPTH_INSIDE[name]
-    # --- extremities ---------------------------------------------------------------------------------
-    extrema = geodesic_extrema(loose, d0, count=6, min_distance=0.15 * H, iterations=4)
-    cand = []
-    for r, c, dist in extrema:
-        p = xyz[r, c]
-        cand.append(((r, c), p, dist, (p - centre) @ axis, (p - centre) @ lat))
+    return d0, loose, centre, axis, lat, facing, view, edge_on, narrow
+
+
+def _pin_along_axis(xyz, mask, cand, centre, axis, lat, facing, up, calib):
+    """Where the torso sits along its axis: the head top (which may also tilt a leaning trunk) and, better,
+    the tops of the shoulders. Returns (head candidate or None, shift or None, centre, axis, lat, facing)."""
+    H = calib.height
     heady = [e for e in cand if (e[1] - centre) @ up > 0 and abs(e[4]) < 0.15 * H]
     head = max(heady, key=lambda e: e[1] @ up, default=None)
     # the head top pins the torso along its axis (the torso patch alone drifts along the body)
@@ -202,130 +261,7 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
             shift = s_shift
     if shift is not None:
         centre = centre + axis * shift
-    def along(h_frac: float) -> np.ndarray:
-        return centre + axis * (h_frac - calib.torso_patch_height) * H
-
-    pos = np.zeros((20, 3))
-    st = np.full(20, INFERRED, np.uint8)
-    for name, hf in (("HipCenter", bm.HEIGHT_HIP_CENTER), ("Spine", bm.HEIGHT_SPINE),
-                     ("ShoulderCenter", bm.HEIGHT_SHOULDER_CENTER)):
-        pos[J[name]] = along(hf) + inside(name)
-        st[J[name]] = TRACKED
-    rest = [e for e in cand if e is not head]
-    feet = sorted([e for e in rest if e[3] < -0.33 * H], key=lambda e: -e[2])[:2]
-    hands = sorted([e for e in rest if e not in feet and e[3] > -0.35 * H and e[2] > 0.22 * H],
-                   key=lambda e: -e[2])[:2]
-    labels = []
-    head_region = None
-    if head is not None:
-        dh = graph.distances(np.array([head[0]]), iterations=3)
-        head_region = dh < HEAD_REGION * H
-        hc = level_set_centroid(xyz, dh, 0.06 * H, band(0.04), head[1], 0.2)
-        pos[J["Head"]] = (hc if hc is not None else head[1] - axis * 0.05 * H) + inside("Head")
-        st[J["Head"]] = TRACKED
-        labels.append(("head", head[1]))
-    else:
-        pos[J["Head"]] = pos[J["ShoulderCenter"]] + axis * (bm.HEIGHT_HEAD - bm.HEIGHT_SHOULDER_CENTER) * H
-    sc, hc_ = pos[J["ShoulderCenter"]], pos[J["HipCenter"]]
-    for s, sign in (("Left", 1.0), ("Right", -1.0)):
-        pos[J[f"Shoulder{s}"]] = sc + lat * sign * bm.SHOULDER_HALF_WIDTH * H - axis * bm.SHOULDER_DROP * H
-        pos[J[f"Hip{s}"]] = hc_ + lat * sign * bm.HIP_HALF_WIDTH * H
-        st[J[f"Shoulder{s}"]] = st[J[f"Hip{s}"]] = TRACKED
-    # --- limbs ---------------------------------------------------------------------------------------
-    limb_specs = (("Shoulder", "Elbow", "Wrist", "Hand", bm.UPPER_ARM, bm.FOREARM, hands, 0.08, 0.08 + bm.HAND * H),
-                  ("Hip", "Knee", "Ankle", "Foot", bm.THIGH, bm.SHIN, feet, 0.07, 0.15))
-    legs_clipped = 0
-    for root, mid, end, tip, r1, r2, found, d_tip, d_end in limb_specs:
-        assign = assign_sides(found, prev if predicted is None else predicted, prev_states, tip)
-        for s in SIDES:
-            e = assign.get(s)
-            a = pos[J[f"{root}{s}"]]
-            l1, l2 = r1 * H, r2 * H
-            if (e is not None and prev is not None and prev_states is not None
-                    and prev_states[J[f"{tip}{s}"]] == TRACKED and np.linalg.norm(e[1] - prev[J[f"{tip}{s}"]]) > 0.45):
-                e = None  # a hand or foot does not jump 45 cm in one frame: another body part's extremity
-            if e is not None and root == "Shoulder" and \
-                    np.linalg.norm(e[1] - a) > 1.2 * (l1 + l2 + bm.HAND * H):
-                e = None  # out of the arm's reach: a knee or foot taken for a hand
-            if e is not None and root == "Shoulder" and (1.0 if s == "Left" else -1.0) * e[4] < -0.1 * H \
-                    and not (prev is not None and np.linalg.norm(e[1] - prev[J[f"{tip}{s}"]]) < 0.15):
-                e = None  # out beyond the other shoulder and not followed there: the other side's part
-
-            def without_extremity():
-                """(end, tip, mid level-set) when no extremity stands for this limb: a hanging arm found in
-                the depth, else the previous frame's limb carried along."""
-                found_arm = _hanging_arm(xyz, mask, a, axis, lat, 1.0 if s == "Left" else -1.0, centre, H) \
-                    if root == "Shoulder" else None
-                if found_arm is None:
-                    return _carry(prev, s, end, tip, a, axis, pos, root)
-                toward = _unit(a - found_arm)
-                tip_p = found_arm + toward * 0.07 + inside(tip)
-                return tip_p + toward * bm.HAND * H, tip_p, None
-
-            if e is not None:
-                de = graph.distances(np.array([e[0]]), iterations=4)
-                tip_p = level_set_centroid(xyz, de, d_tip, band(0.05), e[1], 0.2)
-                end_p = level_set_centroid(xyz, de, d_end, band(0.05), e[1], 0.3)
-                tip_p = (e[1] if tip_p is None else tip_p) + inside(tip)
-                end_p = (tip_p if end_p is None else end_p + inside(end))
-                mid_ls = level_set_centroid(xyz, de, d_end + l2, band(0.06), end_p, l2 + 0.1)
-                labels.append((f"{tip}{s}", e[1]))
-                clipped = at_image_border(grid, (r0 + e[0][0], c0 + e[0][1]))
-                legs_clipped += int(clipped and root == "Hip")
-                truncated = clipped or occluded_end(xyz, mask, e[0])
-                if truncated:  # the limb leaves the image or goes behind the body: its extremity is where the
-                    # view ends, not where the limb does
-                    reach_left = max(0.0, l1 + l2 - np.linalg.norm(end_p - a))
-                    out = _unit(e[1] - a) * TRUNCATED_EXTEND * reach_left
-                    end_p, tip_p = end_p + out, tip_p + out
-                # a true hand/foot lies a limb's length along the surface beyond its shoulder/hip; an
-                # elbow sticking out (hand on the face) or a knee is nearer: keep the guess, flag it
-                root_cell = _nearest_cell(xyz, mask, a)
-                along_limb = e[2] - (d0[root_cell] if root_cell is not None and np.isfinite(d0[root_cell]) else 0.0)
-                st_limb = TRACKED if along_limb > 0.7 * (l1 + l2) and not truncated else INFERRED
-                if st_limb == INFERRED and root == "Shoulder":
-                    # not a hand (an elbow, a shoulder): look for the arm as if no extremity was found
-                    end_p, tip_p, mid_ls = without_extremity()
-            else:
-                end_p, tip_p, mid_ls = without_extremity()
-                st_limb = INFERRED
-            cands, end_p2 = two_bone_candidates(a, end_p, l1, l2)
-            cost = proj.cost(cands, bm.DEPTH_INSIDE[mid])
-            if mid_ls is not None:
-                cost = cost + W_LEVEL_SET * np.linalg.norm(cands - (mid_ls + inside(mid)), axis=1)
-            if prev is not None and prev_states is not None and prev_states[J[f"{mid}{s}"]] != NOT_TRACKED:
-                cost = cost + W_PREVIOUS * np.linalg.norm(cands - prev[J[f"{mid}{s}"]], axis=1)
-            else:  # no history: elbows bend backwards/outwards, knees forwards
-                pref = -view if root == "Hip" else (view + lat * (1 if s == "Left" else -1))
-                cost = cost - 0.02 * ((cands - a) @ _unit(pref))
-            if root == "Hip":  # knees only ever bend forwards: keep them off the back of the circle
-                cost = cost + 0.3 * np.maximum(0.0, -((cands - (a + end_p2) / 2) @ facing))
-                # and stay on their own side of the body (a knee across the midline is the other leg's)
-                cost = cost + W_MIDLINE * np.maximum(0.0, -(1.0 if s == "Left" else -1.0) * ((cands - centre) @ lat))
-            m = cands[int(np.argmin(cost))]
-            pos[J[f"{mid}{s}"]] = m
-            reach_shift = end_p2 - end_p  # keep the hand/foot attached when the end was pulled into reach
-            pos[J[f"{end}{s}"]] = end_p2
-            pos[J[f"{tip}{s}"]] = tip_p + reach_shift
-            if np.linalg.norm(reach_shift) > REACH_SLACK:
-                st_limb = INFERRED  # the extremity is out of this limb's reach: not its hand/foot, or a bad root
-            mid_ok = st_limb == TRACKED and proj.supported(m, bm.DEPTH_INSIDE[mid] - 0.02)
-            st[J[f"{mid}{s}"]] = TRACKED if mid_ok else INFERRED
-            st[J[f"{end}{s}"]] = st[J[f"{tip}{s}"]] = st_limb
-    if ARM_SEARCH:
-        fit_arms(pos, st, xyz, mask, proj, TorsoFrame(centre, axis, lat, facing, pos, H), H, prev, head_region,
-                 settled, facing_steady)
-    # without the head top or the shoulders the torso's place along its axis is a guess; seen more than
-    # TURNED_DEG from the front, shoulders and hips overlap in depth: say so instead of claiming them
-    if shift is None:
-        st[[J["HipCenter"], J["Spine"], J["ShoulderCenter"]]] = INFERRED
-    if legs_clipped == 2:   # both legs leave the image (the SDK's "clipped bottom"): nothing checks the hips
-        st[[J["HipCenter"], J["HipLeft"], J["HipRight"]]] = INFERRED
-    turned = bool(facing @ -view < np.cos(np.radians(TURNED_DEG)))
-    if turned:
-        for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
-            st[J[name]] = INFERRED
-    return FitResult(pos, st, lat, labels, centre, proj, edge_on or narrow, turned)
+    return head, shift, centre, axis, lat, facing
 
 
 def _visible_chest_width(pts, centre, axis, view, H):
@@ -354,31 +290,3 @@ def _shoulder_top(xyz, mask, centre, axis, lat, H, expect):
     if not tops:
         return None
     return min(tops) if len(tops) == 2 and abs(tops[0] - tops[1]) > 0.08 else max(tops)
-
-
-def _hanging_arm(xyz, mask, shoulder, axis, lat, sign, centre, H):
-    """Hand of an arm hanging beside the body (touching it, so no geodesic extremity): the point on that
-    side, outside the torso's width and within reach, farthest below the shoulder."""
-    pts = xyz[mask]
-    rel = pts - centre
-    side = (rel @ lat) * sign
-    below = (shoulder - pts) @ axis
-    reach = np.linalg.norm(pts - shoulder, axis=1)
-    ok = (side > 0.1 * H) & (below > 0.1 * H) & (reach < (bm.UPPER_ARM + bm.FOREARM + bm.HAND) * H + 0.05)
-    if ok.sum() < 5:
-        return None
-    far = np.argsort(-below[ok])[:5]   # a few lowest points: the finger tips
-    tip = pts[ok][far].mean(axis=0)
-    return tip
-
-
-def _carry(prev, s, end, tip, root_pos, axis, pos, root):
-    """A limb with no extremity found: its previous pose moved with the torso, or hanging straight."""
-    if prev is not None:
-        delta = root_pos - prev[J[f"{root}{s}"]]
-        return prev[J[f"{end}{s}"]] + delta, prev[J[f"{tip}{s}"]] + delta, None
-    if root == "Shoulder":
-        e = root_pos - axis * 0.26
-        return e, e - axis * 0.08, None
-    e = root_pos - axis * 0.46
-    return e, e - axis * 0.04 + _unit(-root_pos) * 0.08, None
