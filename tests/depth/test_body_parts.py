@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from kinect_retarget.core.skeletons import KINECT_V1
 from kinect_retarget.depth.body_parts import BACKGROUND, PART, PARTS

@@ -4,13 +4,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kinect_retarget.core.skeletons import KINECT_V1
 from kinect_retarget.lift import LiftError, LiftSettings, lift
 from kinect_retarget.lift import hanim
 from kinect_retarget.lift.bones import lengths_from_take
-from kinect_retarget.sim.lift_scoring import root_relative, tracks_from_take
+from kinect_retarget.sim.lift_scoring import root_relative
 
-from .mocap import IMAGE, camera, rigid, seen_from, true_signs, walking_take
+from .mocap import IMAGE, rigid, seen_from, true_signs, walking_take
 
 
 @pytest.fixture(scope="module")
