@@ -18,17 +18,22 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from _common import shared_data_or_skip  # noqa: E402
+
 from kinect_retarget.core.skeletons import KINECT_V1, KINECT_V2, V1_FROM_V2  # noqa: E402
 from kinect_retarget.core.take import Take  # noqa: E402
 from kinect_retarget.lift.bones import lengths_from_take, standing_height  # noqa: E402
-from kinect_retarget.lift.video_camera import Camera, view_points  # noqa: E402
-from kinect_retarget.sim.lift_scoring import (mpjpe, procrustes_align, root_relative,  # noqa: E402
-                                             sign_flip_fraction, tracks_from_take)
 from kinect_retarget.lift.lifter import LiftSettings, lift  # noqa: E402
 from kinect_retarget.lift.tracks2d import Tracks2D  # noqa: E402
+from kinect_retarget.lift.video_camera import Camera, view_points  # noqa: E402
+from kinect_retarget.sim.lift_scoring import (  # noqa: E402
+    mpjpe,
+    procrustes_align,
+    root_relative,
+    sign_flip_fraction,
+    tracks_from_take,
+)
 from kinect_retarget.takes import bvh, kinectron_json  # noqa: E402
-
-from _common import shared_data_or_skip  # noqa: E402
 
 DATA = shared_data_or_skip(__file__)
 

@@ -125,7 +125,8 @@ def autorig(mesh: Mesh, levels: int = LEVELS, joints: str = "fractions",
               "bound_vertices": int(len(others)), "feature_points": {l: v[i].tolist() for l, i in zip(LABELS, fp.vertices)},
               "up": fp.up.tolist(), "front": fp.front.tolist(), "seconds": time.perf_counter() - t0,
               "timings": timings, "levels": levels, "joint_rule": rule,
-              "normalization": normalization, "mirror": mirror, "points_per_level": paper.count_per_level(levels).tolist()}
+              "normalization": normalization, "mirror": mirror,
+              "points_per_level": paper.count_per_level(levels).tolist()}
     return AutoRig(KINECT_V1, joints, index, weight, body, segment, fp, paper, height, report, v)
 
 

@@ -15,16 +15,16 @@ import numpy as np
 from ..core.conventions import depth_pixel_to_kinect
 from ..core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED, topological_order
 from ..core.take import Take, nominal_rate
-from .bones import DEFAULT_HEIGHT_M, lengths_from_height
-from .video_camera import Camera
 from .bone_depth import jitter_px
+from .bones import DEFAULT_HEIGHT_M, lengths_from_height
 from .gaps import fill_gaps
 from .geometry import JointLines
-from .scale import SCALE_BONES, fill_missing, smooth_lengths, scale_envelope, scale_lower_bound, scale_paper
-from .smoothing import gaussian_kernel, gaussian_smooth
-from .signs import SignPriors, choose_signs
 from .paper_lift import METHODS, continuity_signs, paper_settings
+from .scale import SCALE_BONES, fill_missing, scale_envelope, scale_lower_bound, scale_paper, smooth_lengths
+from .signs import SignPriors, choose_signs
+from .smoothing import gaussian_kernel, gaussian_smooth
 from .tracks2d import LiftError, Tracks2D
+from .video_camera import Camera
 
 SK = KINECT_V1
 PARENTS = SK.parent_array

@@ -4,8 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kinect_retarget.lift import LiftError, LiftSettings, lift
-from kinect_retarget.lift import hanim
+from kinect_retarget.lift import LiftError, LiftSettings, hanim, lift
 from kinect_retarget.lift.bones import lengths_from_take
 from kinect_retarget.sim.lift_scoring import root_relative
 
