@@ -72,10 +72,52 @@ def bake_to_file(take: Take, out_path: str, *, rig_path: str | None = None, arma
     `options` ask; a generated rig's new scene runs at the bake's rate over exactly the baked frames."""
     from .io.rig_export import check_export_path, export_rig
     kind = check_export_path(out_path)  # a wrong extension fails before anything is opened
+    obj, preset = open_target(rig_path, armature, preset, lambda scene: new_generated_rig(scene, take))
+    summary, result = _bake_one(obj, take, rig_path is None, preset, overrides, settings, options)
+    if kind == "blend":
+        save_blend(out_path)
+    else:
+        export_rig(obj, out_path, result.frame_range)
+    return {"out": out_path, **summary}
+
+
+def bake_bodies_to_file(takes: list[Take], out_path: str, *, rig_path: str | None = None,
+                        armatures: list[str | None] | None = None, preset: str = "auto",
+                        overrides: dict | None = None, settings: RetargetSettings | None = None,
+                        options: BakeOptions | None = None) -> dict:
+    """Several performers of one take (`takes[k]` one body each), each baked onto its own armature: the
+    armatures named in rig_path, paired in order, or a generated Kinect rig per body. Saves one .blend;
+    returns {"out", "performers": [one summary per body]}."""
+    from .io.rig_export import check_export_path
+    if check_export_path(out_path) != "blend":
+        raise ValueError(f"{out_path}: several performers go into one .blend; export one body per file "
+                         f"(bake --body N --out NAME.fbx)")
+    names = list(armatures or [None] * len(takes))
+    if len(names) != len(takes):
+        raise ValueError(f"{len(takes)} bodies need {len(takes)} armatures, got {len(names)}")
+    if rig_path:
+        if any(n is None for n in names) or len(set(names)) != len(names):
+            raise ValueError("name a different armature in the rig file for each body (--armature, in order)")
+        open_blend(rig_path)
+        objs = [find_armature(n) for n in names]
+    else:
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        objs = [new_generated_rig(bpy.context.scene, t, f"KinectRig_body{t.metadata.get('body', 0)}")
+                for t in takes]
+        preset = "kinect" if preset == "auto" else preset
+    summaries = []
+    for obj, take in zip(objs, takes):
+        summary, _ = _bake_one(obj, take, rig_path is None, preset, overrides, settings, options)
+        summaries.append({"body": int(take.metadata.get("body", 0)), **summary})
+    save_blend(out_path)
+    return {"out": out_path, "performers": summaries}
+
+
+def _bake_one(obj, take: Take, generated: bool, preset: str, overrides, settings, options):
+    """Bake `take` onto `obj`; (summary, BakeResult)."""
     options = options or BakeOptions()
     messages: list[str] = []
-    obj, preset = open_target(rig_path, armature, preset, lambda scene: new_generated_rig(scene, take))
-    if rig_path is None:  # our own new scene: it runs at the bake's rate over exactly the baked frames
+    if generated:  # our own new scene: it runs at the bake's rate over exactly the baked frames
         options = replace(options, set_scene_fps=True, extend_scene_range=True)
         scene = bpy.context.scene
         scene.frame_start = scene.frame_end = (settings or RetargetSettings()).frame_start
@@ -86,11 +128,7 @@ def bake_to_file(take: Take, out_path: str, *, rig_path: str | None = None, arma
             print(f"warning: {msg}", file=sys.stderr)
     result = bake_take(obj, take, preset=preset, overrides=overrides, settings=settings, options=options,
                        report=report)
-    if kind == "blend":
-        save_blend(out_path)
-    else:
-        export_rig(obj, out_path, result.frame_range)
-    summary = {"out": out_path, "armature": obj.name, "preset": result.preset, "action": result.action.name,
+    summary = {"armature": obj.name, "preset": result.preset, "action": result.action.name,
                "frames": len(result.motion.frames), "frame_range": list(result.frame_range),
                "bones": len(result.motion.bone_names),
                "dropped_joint_samples": int(take.metadata.get("dropped_joint_samples", 0)),
@@ -100,4 +138,4 @@ def bake_to_file(take: Take, out_path: str, *, rig_path: str | None = None, arma
                        max_error_mm=round(result.reduction.max_mm, 4))
     if result.strip:
         summary["nla_strip"] = result.strip
-    return summary
+    return summary, result

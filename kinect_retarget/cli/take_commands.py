@@ -11,7 +11,7 @@ from ..core.bake_options import HAND_MODES, RANGE_UNITS, BakeOptions
 from ..core.filters import FILTERS
 from ..core.presets import PRESET_NAMES
 from ..core.retarget import ROOT_MODES
-from ..takes import load_take
+from ..takes import body_count, load_take
 
 
 def add_parsers(sub) -> None:
@@ -28,8 +28,13 @@ def add_parsers(sub) -> None:
     p.add_argument("take")
     p.add_argument("--out", required=True,
                    help="output .blend, or .fbx / .glb / .gltf / .bvh exported with game-engine settings")
-    p.add_argument("--rig", help=".blend holding the target armature (default: a generated Kinect rig)")
-    p.add_argument("--armature", help="armature object name in --rig (default: the only armature)")
+    p.add_argument("--rig", help=".blend holding the target armature(s) (default: a generated Kinect rig per body)")
+    p.add_argument("--armature", action="append",
+                   help="armature object name in --rig (default: the only armature); repeat it with --body to "
+                        "bake each performer onto its own rig, paired in order")
+    p.add_argument("--body", action="append", type=body_arg,
+                   help="which performer of a take with several (NTU, Kinectron; from 0; default 0); repeat "
+                        "it (one per --armature) or give 'all' to bake every body onto its own rig")
     p.add_argument("--preset", choices=PRESET_NAMES, default="auto")
     p.add_argument("--mapping", help="JSON {bone: joint} overriding the preset per bone")
     p.add_argument("--filter", choices=FILTERS, default="default")
@@ -76,6 +81,39 @@ def add_bake_option_args(p) -> None:
                    help="grow the rig file's scene range to hold the keys (never shortens it)")
 
 
+def body_arg(text: str) -> int | str:
+    if text == "all":
+        return text
+    if not text.isdigit():
+        raise ValueError(f"--body takes a body number from 0 or 'all', not {text!r}")
+    return int(text)
+
+
+def performers(args, bodies_in_take: int) -> list[tuple[int, str | None]]:
+    """(body, armature name or None) for each rig the bake drives, from --body and --armature."""
+    bodies = args.body or [0]
+    names = args.armature or []
+    if "all" in bodies:
+        if len(bodies) > 1:
+            raise ValueError("--body all bakes every body: give it alone")
+        bodies = list(range(bodies_in_take))
+    if len(set(bodies)) != len(bodies):
+        raise ValueError(f"--body repeats a body ({', '.join(map(str, bodies))})")
+    for b in bodies:
+        if b >= bodies_in_take:
+            raise ValueError(f"{args.take}: no body {b} (the take holds {bodies_in_take}, numbered from 0)")
+    if len(bodies) == 1:
+        if len(names) > 1:
+            raise ValueError("several --armature need as many --body (one rig per performer)")
+        return [(bodies[0], names[0] if names else None)]
+    if args.rig and len(names) != len(bodies):
+        raise ValueError(f"{len(bodies)} bodies need {len(bodies)} --armature names in --rig, paired in order "
+                         f"(got {len(names)})")
+    if not args.rig and names:
+        raise ValueError("--armature names armatures in --rig; without --rig each body gets a generated rig")
+    return list(zip(bodies, names or [None] * len(bodies)))
+
+
 def bake_options_from_args(args) -> BakeOptions:
     return BakeOptions(range_start=args.take_start, range_end=args.take_end, range_unit=args.range_unit,
                        step=args.step, reduce=args.reduce, tolerance_deg=args.tolerance_deg,
@@ -98,7 +136,8 @@ def take_summary(path: str) -> dict:
             "joints": len(take.skeleton), "frames": take.frame_count, "duration_s": round(take.duration, 3),
             "rate_fps": take.rate, "time_unit": meta.get("time_unit", "s"),
             "tracked_fraction": round(take.tracked_fraction, 4),
-            "frames_with_body": int(np.count_nonzero(take.any_tracked)), **dropped_summary(meta), **bvh,
+            "frames_with_body": int(np.count_nonzero(take.any_tracked)), "bodies": body_count(take),
+            **dropped_summary(meta), **bvh,
             **({"warnings": meta["warnings"]} if meta.get("warnings") else {})}
 
 
@@ -153,14 +192,22 @@ def run_bake(args) -> int:
     from ..core.presets import load_mapping_file
 
     take = load_take(args.take, scale=args.scale)  # bad input fails here, before Blender starts
-    take.metadata.setdefault("name", os.path.splitext(os.path.basename(args.take))[0])
+    pairs = performers(args, body_count(take))
+    takes = [take if body == 0 else load_take(args.take, body=body) for body, _ in pairs]
+    name = os.path.splitext(os.path.basename(args.take))[0]
+    for (body, _), t in zip(pairs, takes):
+        t.metadata.setdefault("name", name if len(pairs) == 1 else f"{name}_body{body}")
     settings = RetargetSettings(filter=args.filter, root_mode=args.root, fps=args.fps,
                                 frame_start=args.frame_start, mirror=args.mirror, root_scale=args.root_scale)
     options = bake_options_from_args(args)  # bad options fail here too
     overrides = load_mapping_file(args.mapping) if args.mapping else None
-    from ..blender.headless import bake_to_file
+    from ..blender.headless import bake_bodies_to_file, bake_to_file
 
-    result = bake_to_file(take, args.out, rig_path=args.rig, armature=args.armature, preset=args.preset,
-                          overrides=overrides, settings=settings, options=options)
+    if len(pairs) == 1:
+        result = bake_to_file(takes[0], args.out, rig_path=args.rig, armature=pairs[0][1], preset=args.preset,
+                              overrides=overrides, settings=settings, options=options)
+    else:
+        result = bake_bodies_to_file(takes, args.out, rig_path=args.rig, armatures=[a for _, a in pairs],
+                                     preset=args.preset, overrides=overrides, settings=settings, options=options)
     print(json.dumps(result))
     return 0

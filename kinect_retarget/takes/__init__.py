@@ -12,6 +12,8 @@ from ..core.take import Take, TakeError
 
 # Tried in order: the most specific signatures first.
 READERS = ("krtake", "kinectron_json", "bvh", "kinect_v2_csv", "uiprmd", "msrc12", "utkinect", "ntu_skeleton")
+# Formats whose files can hold several performers: their `read(path, body=N)` reads body N (from 0).
+MULTI_BODY = ("kinectron_json", "ntu_skeleton")
 
 
 def detect_format(path: str | os.PathLike) -> str:
@@ -29,9 +31,16 @@ def detect_format(path: str | os.PathLike) -> str:
     raise TakeError(f"{path}: unknown take format (supported: {', '.join(READERS)})")
 
 
-def load_take(path: str | os.PathLike, scale: float | None = None) -> Take:
-    """`scale`: metres per file unit, for BVH files (other formats are in metres already)."""
+def load_take(path: str | os.PathLike, scale: float | None = None, body: int = 0) -> Take:
+    """`scale`: metres per file unit, for BVH files (other formats are in metres already). `body`: which
+    performer of a take with several (NTU, Kinectron; numbered from 0); `metadata["bodies"]` says how many."""
     fmt = detect_format(path)
+    if isinstance(body, bool) or not isinstance(body, int) or body < 0:
+        raise TakeError(f"{os.fspath(path)}: body must be a whole number from 0, got {body!r}")
+    if fmt in MULTI_BODY and scale is None:
+        return import_module(f".{fmt}", __name__).read(path, body=body)
+    if body and fmt not in MULTI_BODY:
+        raise TakeError(f"{os.fspath(path)}: {fmt} takes hold one body (body 0); body {body} was asked for")
     if scale is None:
         return import_module(f".{fmt}", __name__).read(path)
     if fmt != "bvh":
@@ -39,4 +48,9 @@ def load_take(path: str | os.PathLike, scale: float | None = None) -> Take:
     return import_module(f".{fmt}", __name__).read(path, scale=scale)
 
 
-__all__ = ["load_take", "detect_format", "Take", "TakeError", "READERS"]
+def body_count(take: Take) -> int:
+    """How many performers the take's file holds (1 for formats with one)."""
+    return int(take.metadata.get("bodies", 1)) or 1
+
+
+__all__ = ["load_take", "detect_format", "body_count", "Take", "TakeError", "READERS", "MULTI_BODY"]

@@ -4,6 +4,11 @@ Frame: `{bodyIndex, tracked, trackingId, leftHandState, rightHandState, joints[2
 record_timestamp}`; joint: `{depthX, depthY, colorX, colorY, cameraX, cameraY, cameraZ, orientationX..W}`.
 Kinectron reports no per-joint state: every joint of a tracked body is TRACKED, a body with `tracked: false`
 is NOT_TRACKED. `read_with_2d` also returns the depth/colour image coordinates for 2D-to-3D lifting.
+
+Bodies: the tracking ids of tracked records, in the order they first appear. When two ids are ever tracked at
+the same timestamp the file holds several performers and body N is the records of the Nth id only (untracked
+where that id is absent); otherwise it holds one performer, whose id may change when the sensor reacquires
+them, and body 0 takes whichever body is tracked. `metadata["bodies"]` says which case it is.
 """
 from __future__ import annotations
 
@@ -28,11 +33,11 @@ def looks_like(head: bytes) -> bool:
     return text.startswith(b"[") and b'"joints"' in text and b'"cameraX"' in text
 
 
-def read(path: str | os.PathLike) -> Take:
-    return read_with_2d(path)[0]
+def read(path: str | os.PathLike, body: int = 0) -> Take:
+    return read_with_2d(path, body)[0]
 
 
-def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
+def read_with_2d(path: str | os.PathLike, body: int = 0) -> tuple[Take, dict[str, np.ndarray]]:
     """The take plus per-frame, per-joint 2D data (all (F, 25, ...) arrays, NaN where not tracked):
 
     * `depth`, `color`: normalised [0, 1] image coordinates (x right, y down), as Kinectron stores them;
@@ -45,7 +50,10 @@ def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
     """
     path = os.fspath(path)
     frames = _load(path)
-    frames = _one_body_per_time(path, frames)
+    ids = performer_ids(frames)
+    if body >= len(ids):
+        raise TakeError(f"{path}: no body {body} (bodies are numbered from 0; the recording holds {len(ids)})")
+    frames = _one_body_per_time(path, frames, ids[body] if len(ids) > 1 else None)
     n, nj = len(frames), len(KINECT_V2)
     table = np.full((n, nj, len(_FIELDS)), np.nan)
     states = np.zeros((n, nj), dtype=np.uint8)
@@ -76,7 +84,7 @@ def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
     first = frames[int(np.argmax(tracked))][1]
     meta = {"source_file": os.path.basename(path), "time_unit": unit,
             "record_startime_ms": first.get("record_startime"), "tracking_id": str(first.get("trackingId", "")),
-            "first_timestamp": float(times[0])}
+            "first_timestamp": float(times[0]), "bodies": len(ids), **({"body": body} if body else {})}
     # a joint with a NaN or missing image coordinate is as unusable as one with a bad camera position
     before = states
     positions, states = screen_joints(path, table[..., :3], states, records, meta, label="record",
@@ -114,12 +122,33 @@ def _load(path: str) -> list:
     return doc
 
 
-def _one_body_per_time(path: str, frames: list) -> list[tuple[int, dict]]:
-    """Kinectron writes one object per body: keep one per timestamp, the first tracked body (the one
-    with the first tracking id seen, when several are tracked at once)."""
-    first_id = next((f.get("trackingId") for f in frames if f.get("tracked")), None)
+def performer_ids(frames: list) -> list:
+    """The performers' tracking ids in order of appearance when several are tracked at one timestamp, else
+    [None] (one performer, whatever ids the sensor gave them)."""
+    order: dict = {}
+    together: set = set()
+    at: dict = {}
+    for fr in frames:
+        if not fr.get("tracked"):
+            continue
+        tid = fr.get("trackingId")
+        order.setdefault(tid, len(order))
+        seen = at.setdefault(fr.get("record_timestamp"), set())
+        seen.add(tid)
+        if len(seen) > 1:
+            together.update(seen)
+    return [tid for tid in order if tid in together] if together else [None]
+
+
+def _one_body_per_time(path: str, frames: list, want=None) -> list[tuple[int, dict]]:
+    """Kinectron writes one object per body: keep one per timestamp. `want` None: the first tracked body
+    (the one with the first tracking id seen, when several are tracked at once); else only body `want`,
+    an untracked record at timestamps without it."""
+    first_id = want if want is not None else next((f.get("trackingId") for f in frames if f.get("tracked")), None)
     out: list[tuple[int, dict]] = []
     for rec, fr in enumerate(frames):
+        if want is not None and fr.get("trackingId") != want:
+            fr = {**fr, "tracked": False}  # keeps the timestamp; another performer's joints are not ours
         t = fr.get("record_timestamp")
         if out and t is not None and out[-1][1].get("record_timestamp") == t:
             prev = out[-1][1]

@@ -25,8 +25,9 @@ def looks_like(head: bytes) -> bool:
 
 
 def header_dict(skeleton: Skeleton, rate: float, metadata: dict | None = None) -> dict:
-    # `time_unit` describes the file's own time column: the header says it; a source's unit is not carried
-    metadata = {k: v for k, v in (metadata or {}).items() if k != "time_unit"}
+    # `time_unit` describes the file's own time column: the header says it; a source's unit is not carried;
+    # nor is the source's body count (a .krtake holds one body: `body` says which one it was)
+    metadata = {k: v for k, v in (metadata or {}).items() if k not in ("time_unit", "bodies")}
     return {"format": MAGIC, "version": VERSION, "skeleton": skeleton.name, "joints": list(skeleton.joints),
             "rate": float(rate), "units": "m", "space": "kinect_camera", "time_unit": "s",
             "metadata": metadata}

@@ -3,7 +3,9 @@
 Layout: the frame count; per frame a body count; per body a line of 10 values (body id, clipped edges,
 hand confidences and states, restricted, lean x/y, tracking state), the joint count, then one line per joint
 of 12 values: x y z (camera space, metres), depth x y and colour x y (pixels), orientation w x y z, tracking
-state. The first body listed drives the take; frames with no body are NOT_TRACKED (NaN positions).
+state. Body N of a take is the (N+1)th body listed in each frame (NTU lists its performers in a steady order;
+`read(path, body=1)` reads the second performer of a two-person action); frames without that body are
+NOT_TRACKED (NaN positions). `metadata["bodies"]` is the most bodies any frame lists.
 """
 from __future__ import annotations
 
@@ -36,11 +38,11 @@ def looks_like(head: bytes) -> bool:
     return counts[2] == BODY_FIELDS and counts[3] == 1 and lines[3].strip() == b"25"
 
 
-def read(path: str | os.PathLike) -> Take:
-    return read_with_2d(path)[0]
+def read(path: str | os.PathLike, body: int = 0) -> Take:
+    return read_with_2d(path, body)[0]
 
 
-def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
+def read_with_2d(path: str | os.PathLike, body: int = 0) -> tuple[Take, dict[str, np.ndarray]]:
     """The take plus (F, 25, ...) arrays `depth_px`, `color_px` (pixels in the 512x424 depth and
     1920x1080 colour images of the Kinect SDK, which are mirrored: u grows with camera X),
     `depth_px_unmirrored`, `color_px_unmirrored` (u flipped to the project convention, the image as the
@@ -75,10 +77,13 @@ def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
     n_frames = whole(need(0, 1, "frame count"), "frame count")
     if n_frames == 0:
         raise TakeError(f"{path}:1: frame count is 0")
-    layout = _layout_fast(counts[lines], flat[start[lines]], n_frames)
+    layout = _layout_fast(counts[lines], flat[start[lines]], n_frames, body)
     if layout is None:  # something is off: walk the file in order to name the first bad line
-        layout = _layout_walk(path, lines, counts, n_frames, need, whole)
+        layout = _layout_walk(path, lines, counts, n_frames, need, whole, body)
     joint_line, body_count, all_joints = layout
+    if body >= max(1, int(body_count.max())):
+        raise TakeError(f"{path}: no body {body} (bodies are numbered from 0; frames list at most "
+                        f"{int(body_count.max())})")
     # Every joint line at once: check widths, then gather the first bodies' values.
     every = lines[(all_joints[:, None] + np.arange(len(KINECT_V2))).ravel()]
     bad = counts[every] != JOINT_FIELDS
@@ -99,10 +104,10 @@ def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
     states = np.zeros((n_frames, nj), dtype=np.uint8)
     states[has] = state_vals.astype(np.uint8)
     if not np.any(states != NOT_TRACKED):
-        raise TakeError(f"{path}: no tracked body in any of its {n_frames} frames")
+        raise TakeError(f"{path}: no tracked body{f' {body}' if body else ''} in any of its {n_frames} frames")
     times = np.arange(n_frames) / RATE
     meta = {"source_file": os.path.basename(path), "time_unit": FRAME_ORDER, "max_bodies": int(body_count.max()),
-            "frames_without_body": int(np.sum(~has))}
+            "bodies": int(body_count.max()), "frames_without_body": int(np.sum(~has)), **({"body": body} if body else {})}
     where = np.zeros((n_frames, nj), dtype=np.int64)
     where[has] = jl.reshape(-1, nj) + 1
     before = states
@@ -116,8 +121,10 @@ def read_with_2d(path: str | os.PathLike) -> tuple[Take, dict[str, np.ndarray]]:
                   "color_px_unmirrored": unmirror(color, COLOR_SIZE[0]), "body_count": body_count}
 
 
-def _layout_fast(kinds: np.ndarray, first: np.ndarray, n_frames: int):
-    """The frame/body layout from line widths alone (vectorised), or None if it is not consistent."""
+def _layout_fast(kinds: np.ndarray, first: np.ndarray, n_frames: int, body: int = 0):
+    """The frame/body layout from line widths alone (vectorised), or None if it is not consistent:
+    per frame the first joint line of body `body` (-1 where the frame lists fewer), body counts, and the
+    first joint line of every body."""
     per_body = 2 + len(KINECT_V2)
     bodies = np.flatnonzero(kinds == BODY_FIELDS)
     if np.any(bodies + 1 >= kinds.size) or np.any(first[bodies + 1] != len(KINECT_V2)):
@@ -138,14 +145,14 @@ def _layout_fast(kinds: np.ndarray, first: np.ndarray, n_frames: int):
     rank = np.arange(bodies.size) - np.repeat(np.cumsum(nb) - nb, nb)
     if np.any(np.repeat(heads + 1, nb) + per_body * rank != bodies):
         return None
-    joint_line = np.where(nb > 0, heads + 3, -1)
+    joint_line = np.where(nb > body, heads + 3 + per_body * body, -1)
     return joint_line, nb, bodies + 2
 
 
-def _layout_walk(path, lines, counts, n_frames, need, whole):
+def _layout_walk(path, lines, counts, n_frames, need, whole, body: int = 0):
     """Walk frame by frame; raises TakeError at the first line that breaks the layout."""
     k = 1
-    joint_line = np.full(n_frames, -1, dtype=np.int64)  # first joint line of the first body, per frame
+    joint_line = np.full(n_frames, -1, dtype=np.int64)  # first joint line of body `body`, per frame
     body_count = np.zeros(n_frames, dtype=np.int64)
     all_joints: list[int] = []                           # first joint line of every body
     for f in range(n_frames):  # body counts vary per frame: the layout can only be walked in order
@@ -160,7 +167,7 @@ def _layout_walk(path, lines, counts, n_frames, need, whole):
             if k + 2 + nj > lines.size:
                 raise TakeError(f"{path}:{int(lines[-1]) + 1}: file ends inside frame {f + 1} (truncated?)")
             all_joints.append(k + 2)
-            if b == 0:
+            if b == body:
                 joint_line[f] = k + 2
             k += 2 + nj
     if k < lines.size:

@@ -31,27 +31,23 @@ def _lines(rows: np.ndarray, fmt: str) -> str:
     return "".join(fmt % tuple(r) + "\n" for r in rows)
 
 
-def write_ntu(take: Take, path: Path, second_body: slice = slice(0, 0)) -> None:
-    """NTU .skeleton; frames where nothing is tracked get 0 bodies; `second_body` frames get a second,
-    shifted person listed after the first."""
+def write_ntu(take: Take, path: Path, second_body: slice = slice(0, 0), second: Take | None = None) -> None:
+    """NTU .skeleton; frames where nothing is tracked get 0 bodies; `second_body` frames get a second
+    person listed after the first: `second`'s frames (as many as `take`'s) 1 m along X, else the first
+    shifted 1 m."""
     f, nj = take.states.shape
-    pos = np.nan_to_num(take.positions)
-    safe = np.where(pos[..., 2:] > 0, pos, [0, 0, 1])
-    # NTU stores the Kinect SDK's pixel coordinates, whose images are mirrored: u = W - 1 - u(camera view).
-    depth = kinect_to_depth_pixel(safe, *DEPTH_CAMERA) * [-1, 1] + [511, 0]
-    color = kinect_to_depth_pixel(safe, *COLOR_CAMERA) * [-1, 1] + [1919, 0]
-    orient = np.zeros((f, nj, 4))
-    table = np.concatenate([pos, depth, color, orient, take.states[..., None]], axis=2)
+    table = _ntu_table(take)
+    other_table = table if second is None else _ntu_table(second)
     joint_fmt = "%.7g %.7g %.7g %.7g %.7g %.7g %.7g %.7g %.7g %.7g %.7g %d"
-    second = np.zeros(f, dtype=bool)
-    second[second_body] = True
+    present = np.zeros(f, dtype=bool)
+    present[second_body] = True
     out = [f"{f}\n"]
     for i in range(f):
         bodies = []
         if np.any(take.states[i] != NOT_TRACKED):
             bodies.append(("72057594037931101", table[i]))
-            if second[i]:
-                other = table[i].copy()
+            if present[i]:
+                other = other_table[i].copy()
                 other[:, 0] += 1.0
                 bodies.append(("72057594037931117", other))
         out.append(f"{len(bodies)}\n")
@@ -59,6 +55,18 @@ def write_ntu(take: Take, path: Path, second_body: slice = slice(0, 0)) -> None:
             out.append(f"{body_id} 0 1 1 1 1 0 0.01237284 -0.04561102 2\n{nj}\n")
             out.append(_lines(rows, joint_fmt))
     path.write_text("".join(out))
+
+
+def _ntu_table(take: Take) -> np.ndarray:
+    """(F, J, 12) NTU joint lines: position, depth and colour pixels, orientation, state."""
+    f, nj = take.states.shape
+    pos = np.nan_to_num(take.positions)
+    safe = np.where(pos[..., 2:] > 0, pos, [0, 0, 1])
+    # NTU stores the Kinect SDK's pixel coordinates, whose images are mirrored: u = W - 1 - u(camera view).
+    depth = kinect_to_depth_pixel(safe, *DEPTH_CAMERA) * [-1, 1] + [511, 0]
+    color = kinect_to_depth_pixel(safe, *COLOR_CAMERA) * [-1, 1] + [1919, 0]
+    orient = np.zeros((f, nj, 4))
+    return np.concatenate([pos, depth, color, orient, take.states[..., None]], axis=2)
 
 
 def write_msrc12(take: Take, path: Path, time_offset: float = 0.0) -> None:
