@@ -107,7 +107,8 @@ def read_with_2d(path: str | os.PathLike, body: int = 0) -> tuple[Take, dict[str
         raise TakeError(f"{path}: no tracked body{f' {body}' if body else ''} in any of its {n_frames} frames")
     times = np.arange(n_frames) / RATE
     meta = {"source_file": os.path.basename(path), "time_unit": FRAME_ORDER, "max_bodies": int(body_count.max()),
-            "bodies": int(body_count.max()), "frames_without_body": int(np.sum(~has)), **({"body": body} if body else {})}
+            "bodies": int(body_count.max()), "frames_without_body": int(np.sum(~has)),
+            **({"body": body} if body else {})}
     where = np.zeros((n_frames, nj), dtype=np.int64)
     where[has] = jl.reshape(-1, nj) + 1
     before = states
