@@ -5,16 +5,16 @@ from __future__ import annotations
 
 import bpy
 
-from . import clip_lift, mesh_autorig
 from .live import live_runtime, record_countdown, usb_service
-from .ui import (bake_operator, live_operators, mapping_table, menus, panels, preferences, properties,
-                 takes_list, usb_panel)
+from .ui import (autorig_operator, bake_operator, clip_operators, live_operators, mapping_table, menus, panels,
+                 preferences, properties, takes_list, usb_panel)
 
 CLASSES = (*bake_operator.CLASSES, *preferences.CLASSES, *properties.CLASSES, *live_operators.CLASSES,
            *mapping_table.CLASSES, *panels.CLASSES, *takes_list.CLASSES, *usb_panel.CLASSES,
-           *mesh_autorig.CLASSES, *clip_lift.CLASSES, *menus.CLASSES)
+           *autorig_operator.CLASSES, *clip_operators.CLASSES, *menus.CLASSES)
 # modules with register_extra()/unregister_extra(), in order
-HOOKS = (properties, live_runtime, usb_service, usb_panel, mesh_autorig, clip_lift, menus, record_countdown)
+HOOKS = (properties, live_runtime, usb_service, usb_panel, autorig_operator, clip_operators, menus,
+         record_countdown)
 
 _done = {"classes": 0, "hooks": 0}   # how far register() got, so unregister() undoes exactly that
 
