@@ -60,6 +60,20 @@ class KINECT_RETARGET_OT_lift_clip(bpy.types.Operator):
             self.armature = obj.name
         return context.window_manager.invoke_props_dialog(self)
 
+    def draw(self, context):
+        layout = self.layout
+        layout.prop(self, "armature")
+        col = layout.column()
+        col.active = self.armature != NEW_HANIM  # the H-Anim figure is keyed directly, no preset
+        col.prop(self, "preset")
+        layout.prop(self, "method")
+        layout.prop(self, "height")
+        col = layout.column()
+        col.active = self.method != "paper"  # the paper's camera is orthographic and its signs its own
+        col.prop(self, "use_clip_camera")
+        col.prop(self, "signs")
+        layout.prop(self, "take_path")
+
     def execute(self, context):
         clip = _active_clip(context)
         try:
