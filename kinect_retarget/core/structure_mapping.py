@@ -40,7 +40,7 @@ import numpy as np
 from .floor_plane import estimate_up
 from .rest_limbs import best_triple, big_branches, head_base, longest_leg, rest_leg, wrist_fan
 from .skeletons import KINECT_V1
-from .structure_names import kinect_names, name_side
+from .structure_names import branch_side, kinect_names
 
 ROLES = KINECT_V1.joints
 SHORT = 0.03        # a segment shorter than this fraction of the figure's size is a zero-length helper
@@ -351,7 +351,8 @@ class _Mapper:
                      for leg in (leg_a, leg_b)]
             score, how = vote(knees), "knees"
         if abs(score) < 0.15:
-            la = self._side_name(legs[0]) - self._side_name(legs[1])
+            la = (branch_side(self.names, self.kids, self.reach, legs[0])
+                  - branch_side(self.names, self.kids, self.reach, legs[1]))
             score, how = (float(np.sign(la)) if la else 1.0), ("joint names" if la else "default (no evidence)")
             self.notes.append(f"left and right decided by {how}: the figure's toes and knees do not tell")
         forward = np.median(f0, axis=0) * np.sign(score)
@@ -359,16 +360,6 @@ class _Mapper:
         forward /= max(np.linalg.norm(forward), 1e-12)
         self.notes.append(f"facing from the {how}")
         return forward, score > 0
-
-    def _side_name(self, branch: int) -> int:
-        """+1 if the names below `branch` say left, -1 right, 0 unknown."""
-        j, votes = branch, 0
-        for _ in range(4):
-            votes += name_side(self.names[j])
-            if not self.kids[j]:
-                break
-            j = max(self.kids[j], key=lambda c: self.reach[c])
-        return int(np.sign(votes))
 
     def _roles(self, pelvis, chest, spine, head_chain, top, arm_l, arm_r, leg_l, leg_r) -> dict[str, RoleMatch]:
         nm = self.names

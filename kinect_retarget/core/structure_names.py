@@ -22,6 +22,17 @@ def name_side(name: str) -> int:
     return 0
 
 
+def branch_side(names, kids, reach, branch: int) -> int:
+    """+1 if the names of the first nodes down `branch`'s longest path say left, -1 right, 0 unknown."""
+    j, votes = branch, 0
+    for _ in range(4):
+        votes += name_side(names[j])
+        if not kids[j]:
+            break
+        j = max(kids[j], key=lambda c: reach[c])
+    return (votes > 0) - (votes < 0)
+
+
 def kinect_names(names, ends, roles: dict, notes: list) -> dict:
     """A Kinect-named skeleton (v1 or v2 joint names) maps one to one wherever it names the joint, provided
     the named nodes sit where the structure found those joints (`roles`: structure_mapping's RoleMatch)."""

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from kinect_retarget.core.skeletons import KINECT_V2
-from kinect_retarget.core.structure_mapping import ROLES, StructureError, map_structure, name_side
+from kinect_retarget.core.structure_mapping import ROLES, StructureError, map_structure
+from kinect_retarget.core.structure_names import name_side
 from kinect_retarget.takes import load_take
 from kinect_retarget.takes.bvh import read_bvh_skeleton
 
