@@ -7,6 +7,7 @@ elsewhere may instead carry times (F,) seconds and gravity (3,).
 from __future__ import annotations
 
 import json
+import zipfile
 
 import numpy as np
 
@@ -58,8 +59,10 @@ def load_capture(path: str):
     """(mm (F, 480, 640) uint16, times (F,), gravity or None); TakeError names the problem."""
     try:
         data = np.load(path, allow_pickle=False)
-    except (OSError, ValueError) as exc:
-        raise TakeError(f"{path}: not a readable depth capture (.npz): {exc}") from None
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:  # empty or cut-off files included
+        raise TakeError(f"{path}: not a readable depth capture (.npz): {exc or type(exc).__name__}") from None
+    if not hasattr(data, "files"):  # a single .npy array, not an archive of named arrays
+        raise TakeError(f"{path}: not a depth capture (.npz): the file holds one unnamed array (.npy)")
     with data:
         keys = set(data.files)
         if "mm" in keys:

@@ -55,6 +55,21 @@ def test_not_an_npz_and_missing_file(tmp_path, capsys):
     assert "no such file" in capsys.readouterr().err
 
 
+
+def test_empty_cut_off_and_single_array_captures_are_clear_errors(tmp_path, capsys):
+    whole = tmp_path / "whole.npz"
+    np.savez(whole, mm=np.zeros((2, 480, 640), np.uint16))
+    empty, cut, single = tmp_path / "empty.npz", tmp_path / "cut.npz", tmp_path / "single.npz"
+    empty.write_bytes(b"")
+    cut.write_bytes(whole.read_bytes()[:1000])  # a copy interrupted early: no zip directory at the end
+    with open(single, "wb") as f:
+        np.save(f, np.zeros(3))
+    for path, message in ((empty, "not a readable depth capture"), (cut, "not a readable depth capture"),
+                          (single, "one unnamed array")):
+        assert main(["track", str(path), "--out", str(tmp_path / "x.krtake")]) == 2
+        err = capsys.readouterr().err
+        assert message in err and str(path) in err
+
 def test_all_zero_capture_gives_an_untracked_take(tmp_path):
     path = tmp_path / "empty.npz"
     np.savez(path, mm=np.zeros((3, 480, 640), np.uint16))
