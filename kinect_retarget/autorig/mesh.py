@@ -192,6 +192,21 @@ def load_ply(path: str | Path) -> Mesh:
             elements[-1][2].append(t[1:])
     if fmt not in ("ascii", "binary_little_endian", "binary_big_endian"):
         raise MeshError(f"{path}: unsupported PLY format {fmt!r}")
+    try:
+        verts, faces = _ply_body(path, data, body_start, fmt, elements)
+    except MeshError:
+        raise
+    except (ValueError, IndexError, KeyError) as exc:  # fewer values than the header promises, or odd ones
+        raise MeshError(f"{path}: PLY data do not match its header (truncated or corrupt file: {exc})") from None
+    if verts is None:
+        raise MeshError(f"{path}: PLY has no vertex element")
+    if faces is None or len(faces) == 0:
+        raise MeshError(f"{path}: {len(verts)} vertices but no faces (a point cloud, not a surface mesh)")
+    return Mesh(verts, faces, path.stem)
+
+
+def _ply_body(path: Path, data: bytes, body_start: int, fmt: str, elements: list) -> tuple:
+    """(vertices or None, triangles or None) from a PLY's data after its header."""
     verts = faces = None
     if fmt == "ascii":
         tokens = data[body_start:].split()
@@ -233,11 +248,7 @@ def load_ply(path: str | Path) -> Mesh:
                 pos += count * dt.itemsize
                 if name == "vertex":
                     verts = np.stack([arr[c].astype(np.float64) for c in "xyz"], axis=1)
-    if verts is None:
-        raise MeshError(f"{path}: PLY has no vertex element")
-    if faces is None or len(faces) == 0:
-        raise MeshError(f"{path}: {len(verts)} vertices but no faces (a point cloud, not a surface mesh)")
-    return Mesh(verts, faces, path.stem)
+    return verts, faces
 
 
 def load_glb(path: str | Path) -> Mesh:

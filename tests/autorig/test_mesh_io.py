@@ -43,6 +43,18 @@ def test_ply_ascii_and_binary(tmp_path):
         assert m.faces.tolist() == [[0, 1, 2], [0, 1, 3], [0, 3, 2]]
 
 
+
+def test_cut_off_ply_names_the_file(tmp_path):
+    header = "ply\nformat {}\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n" \
+             "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+    a = tmp_path / "a.ply"
+    a.write_text(header.format("ascii 1.0") + "0 0 0\n1 0")
+    b = tmp_path / "b.ply"
+    b.write_bytes(header.format("binary_little_endian 1.0").encode() + V.astype("<f4").tobytes()[:20])
+    for p in (a, b):
+        with pytest.raises(MeshError, match=f"{p.name}: PLY data do not match its header"):
+            load_mesh(p)
+
 def test_point_cloud_ply_is_refused(tmp_path):
     p = tmp_path / "cloud.ply"
     p.write_text("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
