@@ -27,6 +27,8 @@ def find_armature(name: str | None) -> bpy.types.Object:
         view_layer = bpy.context.view_layer
         visible = [o for o in arms if o.name in view_layer.objects and o.visible_get(view_layer=view_layer)]
         arms = visible if len(visible) == 1 else arms
+    if not arms:
+        raise ValueError("no armature in the file: save the rig (an Armature object) in it")
     if len(arms) != 1:
         raise ValueError(f"{len(arms)} armatures in the file ({listing}): name one with --armature")
     return arms[0]

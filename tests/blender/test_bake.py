@@ -243,6 +243,11 @@ def test_cli_rig_errors_and_visible_armature(bpy_empty, shared_data, tmp_path):
                         "--out", str(out)], capture_output=True, text=True)
     assert r.returncode == 2 and "junk.blend: not a readable .blend file" in r.stderr
     assert "Traceback" not in r.stderr
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "no_rig.blend"))
+    r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(take_path), "--rig",
+                        str(tmp_path / "no_rig.blend"), "--out", str(out)], capture_output=True, text=True)
+    assert r.returncode == 2 and "no armature in the file" in r.stderr and "--armature" not in r.stderr
 
 
 def test_operator_uses_the_sidebar_target_and_mapping_table(registered, shared_data):
