@@ -88,7 +88,8 @@ class FrameSource:
             return not self._stop.wait(seconds)
         return not self._stop.is_set()
 
-    def _emit(self, positions: np.ndarray, states: np.ndarray, time_s: float, where: str = "") -> None:
+    def _emit(self, positions: np.ndarray, states: np.ndarray, time_s: float, where: str = "",
+              body: int = 0) -> None:
         positions = np.asarray(positions, dtype=np.float64)
         states = np.asarray(states, dtype=np.uint8)
         j = len(self.skeleton)
@@ -103,7 +104,7 @@ class FrameSource:
             raise SourceError(f"{self.describe()}{where}: timestamp is not a number")
         positions = np.where(np.isfinite(positions), positions, 0.0)
         assert self._queue is not None
-        self._queue.put(SkeletonFrame(positions, states, float(time_s), time.perf_counter()))
+        self._queue.put(SkeletonFrame(positions, states, float(time_s), time.perf_counter(), body))
         self.frames_emitted += 1
 
     def fail(self, message: str) -> None:

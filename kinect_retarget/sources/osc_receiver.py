@@ -6,9 +6,18 @@ packet is counted, shown (`warning`) and skipped, since one stray datagram must 
 errors stop the receiver. A frame ends at
 `/NI_mate_sync`, at the end of a bundle, or when a joint repeats (senders without sync markers).
 Positions are taken as Kinect camera space metres (NI mate's skeleton output; see docs/live.md).
+
+Several performers on one stream: NI mate numbers its users (its `[U]` address tag), other bridges
+likewise. A user number in the address picks the performer: a suffix, `/Left_Hand_2` (NI mate's
+`/Left_Hand_[U]`), or a first address part, `/2/Left_Hand`, `/user2/Left_Hand`, `/skeleton_2/left_hand`.
+Users are numbered from `first_user` (NI mate: 1): user `first_user + n` is body n; an address without a
+number is body 0. Each user's joints are assembled on their own; a sync message or the end of a bundle ends
+every user's frame, a repeated joint only that user's. Frames carry their body (sources/body_fanout.py
+routes them to one rig each).
 """
 from __future__ import annotations
 
+import re
 import socket
 import time
 
@@ -106,16 +115,68 @@ class FrameAssembler:
             st[r] = INFERRED
 
 
+_PREFIX = re.compile(r"^/(?:user_?|skeleton_?|u)?(\d+)(/.+)$", re.IGNORECASE)
+_SUFFIX = re.compile(r"^(/.+?)_(\d+)$")
+MAX_BODIES = 16  # more users than any sensor tracks: a number beyond is an address we do not know
+
+
+class UserFrames:
+    """Feed OSC messages; get back (body, positions, states) for every frame a message completes."""
+
+    def __init__(self, skeleton: Skeleton, first_user: int = 1):
+        self.skeleton = skeleton
+        self.first_user = int(first_user)
+        self.users: dict[int, FrameAssembler] = {}
+        self.ignored: set[str] = set()
+
+    def split(self, address: str) -> tuple[int, str]:
+        """(body, address without the user number)."""
+        lookup = self._assembler(0).lookup
+        for pattern, joint_part, user_part in ((_PREFIX, 2, 1), (_SUFFIX, 1, 2)):
+            m = pattern.match(address)
+            if m is None or address[1:].lower().replace("/", "_") in lookup:
+                continue
+            body = int(m.group(user_part)) - self.first_user
+            if 0 <= body < MAX_BODIES:
+                return body, m.group(joint_part)
+        return 0, address
+
+    def feed(self, address: str, args: list) -> list[tuple[int, np.ndarray, np.ndarray]]:
+        if address.lower() in SYNC_ADDRESSES:
+            return self.flush()
+        body, joint = self.split(address)
+        asm = self._assembler(body)
+        done = asm.feed(joint, args)
+        if asm.ignored:  # shown as sent, with its user number
+            self.ignored.add(address[:64])
+            asm.ignored.clear()
+        return [] if done is None else [(body, *done)]
+
+    def flush(self) -> list[tuple[int, np.ndarray, np.ndarray]]:
+        out = []
+        for body in sorted(self.users):
+            done = self.users[body].flush()
+            if done is not None:
+                out.append((body, *done))
+        return out
+
+    def _assembler(self, body: int) -> FrameAssembler:
+        asm = self.users.get(body)
+        if asm is None:
+            asm = self.users[body] = FrameAssembler(self.skeleton)
+        return asm
+
+
 class OscReceiver(FrameSource):
     kind = "osc"
 
     def __init__(self, port: int = 7000, host: str = "127.0.0.1", skeleton: Skeleton = KINECT_V2,
-                 rate: float = 30.0):
+                 rate: float = 30.0, first_user: int = 1):
         if not (0 <= int(port) <= 65535):
             raise SourceError(f"OSC port {port} is out of range 0-65535")
         super().__init__(skeleton, rate)
         self.host, self.port = host, int(port)
-        self.assembler = FrameAssembler(skeleton)
+        self.assembler = UserFrames(skeleton, first_user)
         self.packets = 0
         self.bad_packets = 0
         self._sock: socket.socket | None = None
@@ -155,13 +216,11 @@ class OscReceiver(FrameSource):
                 messages = parse_packet(data)
                 is_bundle = data.startswith(b"#bundle")
                 for address, args in messages:
-                    frame = self.assembler.feed(address, args)
-                    if frame is not None:
-                        self._emit(frame[0], frame[1], time.perf_counter(), where=f" packet {self.packets}")
-                if is_bundle:  # a bundle holds one whole frame
-                    frame = self.assembler.flush()
-                    if frame is not None:
-                        self._emit(frame[0], frame[1], time.perf_counter(), where=f" packet {self.packets}")
+                    for body, pos, st in self.assembler.feed(address, args):
+                        self._emit(pos, st, time.perf_counter(), where=f" packet {self.packets}", body=body)
+                if is_bundle:  # a bundle holds one whole frame (of every user in it)
+                    for body, pos, st in self.assembler.flush():
+                        self._emit(pos, st, time.perf_counter(), where=f" packet {self.packets}", body=body)
             except OscError as exc:  # never evaluated, never fatal: count it, say which, go on
                 self.bad_packets += 1
                 self.warning = (f"{self.describe()}: {self.bad_packets} bad OSC packet(s) ignored; latest, "

@@ -8,13 +8,14 @@ from .usb_kinect import UsbKinectSource
 
 
 def open_source(spec: str, speed: float = 1.0, loop: bool = False, host: str = "127.0.0.1",
-                simulate: bool = False, usb_backend=None) -> FrameSource:
+                simulate: bool = False, usb_backend=None, bodies: tuple[int, ...] = (0,)) -> FrameSource:
     """A frame source, not started. `simulate`: the USB source is the emulated Kinect streaming rendered depth
     of real mocap (emulated USB -> depth -> skeleton); `usb_backend`: a pyusb backend to open instead of the
-    system's (the sidebar's prepared simulated Kinect)."""
+    system's (the sidebar's prepared simulated Kinect); `bodies`: the performers of a take file to play
+    together (OSC sends every user it sees)."""
     kind, _, arg = spec.partition(":")
     if kind == "take" and arg:
-        return TakePlayback(arg, speed=speed, loop=loop)
+        return TakePlayback(arg, speed=speed, loop=loop, bodies=bodies)
     if kind == "osc":
         try:
             port = int(arg or 7000)

@@ -1,7 +1,9 @@
 """The live controller (main thread only): one live run on one rig. It owns the bpy-free LiveSession (drain,
 filter, retarget, record), poses the rig with the newest frame, records, bakes the recording, calibrates, and
 puts the rig back when it stops. Live pushes no undo steps and holds object names, never bpy references.
-Starting, pumping and stopping the one running controller is live_runtime.py's job.
+Starting, pumping and stopping the one running controller is live_runtime.py's job. With several performers
+(one source's bodies, sources/body_fanout.py) the running controller leads `followers`, one controller per
+other rig: they start, pump, record, bake, calibrate and stop with it.
 """
 from __future__ import annotations
 
@@ -86,8 +88,26 @@ class LiveController:
         wanted = settings.hands == "on" or (settings.hands == "auto" and "HandTipLeft" in joints)
         self.hands = hands_on_rig(obj, pipeline.retargeter.mapped) if wanted else []
         self._joints = joints
+        self.body = int(getattr(source, "body", 0))
+        self.followers: list[LiveController] = []
+        self.finished = False
 
     def start(self) -> None:
+        """Start this rig, then its followers; when one fails, those started stop and the error goes up."""
+        self._start_one()
+        started = []
+        try:
+            for f in self.followers:
+                f._start_one()
+                started.append(f)
+        except Exception:
+            for f in started + [self]:
+                f.session.stop()
+                f.release_evaluator()
+                restore_rig_state(f.obj(), f._saved, keep_animation=False)
+            raise
+
+    def _start_one(self) -> None:
         """Save the rig's state, switch Rigify limbs to FK, learn its constrained parents, start the source; on
         any failure the rig gets its pose, action and switches back before the error goes up."""
         obj = self.obj()
@@ -164,6 +184,9 @@ class LiveController:
     # -- pumping ---------------------------------------------------------------------------------------------
     def pump(self) -> bool:
         alive = self.session.pump()
+        for f in self.followers:
+            if not f.finished and not f.session.pump():
+                f.finish()
         if not alive:
             self.finish()
         return alive
@@ -182,6 +205,10 @@ class LiveController:
             path, suffix = unused_path(folder, f"{bpy.path.clean_name(self.obj_name)}_{stamp}", ".krtake")
             stamp += suffix  # the action is named like its file
         name = f"{self.obj_name}_live_{stamp}"
+        for f in self.followers:  # each performer to its own file, beside this one when a path was given
+            if f.session.running:
+                base, ext = os.path.splitext(path) if path is not None else (None, None)
+                f.start_recording(None, f"{base}_body{f.body}{ext}" if base is not None else None, play=False)
         try:
             self.session.start_recording(path, {"name": name, "armature": self.obj_name,
                                                 "source": self.source_label})
@@ -202,6 +229,8 @@ class LiveController:
     def stop_recording(self, bake: bool, context=None, undo_step: bool = True) -> str | None:
         """Stop recording, keep the take, bake it when asked; the bake is one undo step (pushed here, or by
         finish() once the rig's pose is restored when `undo_step` is False)."""
+        for f in self.followers:
+            f.stop_recording(bake, context, undo_step)
         rec, self.recording = self.recording, None
         if rec is None:
             return None
@@ -250,6 +279,8 @@ class LiveController:
 
     # -- calibration -----------------------------------------------------------------------------------------
     def calibrate(self, seconds: float = 1.0) -> None:
+        for f in self.followers:
+            f.calibrate(seconds)
         self.message = "Calibrating: stand still in a T-pose or A-pose"
         self.session.start_calibration(self._calibrated, seconds)
 
@@ -283,6 +314,9 @@ class LiveController:
         Bake on Stop is on), pose, timer."""
         if bake is None:
             bake = self.bake_on_stop()
+        for f in self.followers:  # before this rig's own source view: the last view stops the shared source
+            if not f.finished:
+                f.finish(bake=bake, context=context)
         session = self.session
         session.stop()
         record_countdown.cancel()  # stopping live calls off a recording not yet started
@@ -299,5 +333,6 @@ class LiveController:
             self.post("ERROR", f"Live stopped: {session.error}")
         elif not self.message.startswith("Baked"):
             self.message = "Live stopped"
+        self.finished = True
         if self.on_finish is not None:
             self.on_finish(self)

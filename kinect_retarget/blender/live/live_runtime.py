@@ -15,7 +15,9 @@ from bpy.app.handlers import persistent
 
 from ...core.pipeline import RetargetSettings
 from ...sources import SourceError, TakePlayback, open_source
+from ...sources.body_fanout import BodyFanout
 from ..ui.mapping_table import table_overrides
+from ..ui.performers import other_performers
 from ..ui.preferences import get_preferences
 from ..ui.properties import ensure_defaults, target_armature
 from .live_controller import LiveController, LiveSettings
@@ -69,14 +71,20 @@ def _finished(c: LiveController) -> None:
 
 
 # -- the sidebar's choices ------------------------------------------------------------------------------------
+def performers_from_scene(context) -> tuple[int, list[tuple]]:
+    """(the target's body, [(armature, body)] of the sidebar's other performers that name an armature)."""
+    return context.scene.kinect_retarget.body, other_performers(context.scene)
+
+
 def source_from_scene(context) -> tuple:
     """The source the sidebar names, not started, and its label for messages."""
     s = context.scene.kinect_retarget
     if s.source == "TAKE":
         if not s.take_path:
             raise SourceError("choose a take file to play")
-        return open_source(f"take:{bpy.path.abspath(s.take_path)}", speed=s.speed, loop=s.loop), \
-            f"take {os.path.basename(s.take_path)}"
+        body, others = performers_from_scene(context)
+        return open_source(f"take:{bpy.path.abspath(s.take_path)}", speed=s.speed, loop=s.loop,
+                           bodies=tuple({body, *(b for _, b in others)})), f"take {os.path.basename(s.take_path)}"
     if s.source == "OSC":
         host, refused = osc_host(get_preferences(context))
         return open_source(f"osc:{s.osc_port}", host=host), \
@@ -98,10 +106,13 @@ def settings_from_scene(context) -> tuple[LiveSettings, dict | None]:
 
 # -- the functions operators, the CLI and tests call ----------------------------------------------------------
 def start_live(context, source=None, settings: LiveSettings | None = None, overrides=None, *, armature=None,
-               use_timer: bool = True) -> LiveController:
+               use_timer: bool = True, body: int | None = None, followers=None) -> LiveController:
     """Start live on `armature` (default: the sidebar's target) from `source` with `settings` and mapping
-    `overrides`; a None source or settings is taken from the sidebar. Raises SourceError/ValueError with a
-    user sentence, with the rig left as it was."""
+    `overrides`; a None source or settings is taken from the sidebar. `body` (default: the sidebar's) is the
+    performer this rig follows; `followers` [(armature, body)] (default: the sidebar's other performers when
+    the source is the sidebar's) drive more rigs from the same source, one body each, with the same settings
+    and their preset's mapping. Raises SourceError/ValueError with a user sentence, with the rigs left as
+    they were."""
     global _controller
     if _controller is not None:
         raise SourceError("live is already running")
@@ -114,9 +125,26 @@ def start_live(context, source=None, settings: LiveSettings | None = None, overr
     if settings is None:
         settings, overrides = settings_from_scene(context)
     label = source.describe() if source is not None else ""
+    if body is None or (followers is None and source is None):
+        ensure_defaults(scene, context)
+        scene_body, scene_followers = performers_from_scene(context)
+        body = scene_body if body is None else body
+        followers = scene_followers if followers is None and source is None else followers
+    followers = list(followers or [])
     if source is None:
         source, label = source_from_scene(context)
+    if len({body, *(b for _, b in followers)}) != 1 + len(followers):
+        raise ValueError("each performer drives one rig: give every target its own body")
+    if len({obj.name, *(o.name for o, _ in followers)}) != 1 + len(followers):
+        raise ValueError("each rig follows one performer: pick a different armature for every target")
+    follower_controllers: list[LiveController] = []
+    if followers or body:  # one source, several bodies: each rig's session sees its own body's frames
+        fanout = BodyFanout(source)
+        source = fanout.body(body)
+        follower_controllers = [LiveController(scene, o, fanout.body(b), settings, None, f"{label} body {b}")
+                                for o, b in followers]
     controller = LiveController(scene, obj, source, settings, overrides, label, on_finish=_finished)
+    controller.followers = follower_controllers
     controller.start()
     _controller = controller
     _last_status.update(state="running", message=controller.message, error=None, stats=None)
@@ -152,7 +180,8 @@ def status() -> dict:
             "tracked": c.session.last_tracked_joints, "joints": len(src.skeleton),
             "calibrating": c.session.calibrating, "device": getattr(src, "device_status", None),
             "progress": (src.position + 1, src.take.frame_count) if isinstance(src, TakePlayback) else None,
-            "recording": c.recording["path"] if c.recording else None}
+            "recording": c.recording["path"] if c.recording else None,
+            "performers": [(c.obj_name, c.body)] + [(f.obj_name, f.body) for f in c.followers if not f.finished]}
 
 
 def set_error_status(message: str) -> None:

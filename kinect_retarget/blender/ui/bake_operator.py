@@ -8,10 +8,11 @@ from bpy_extras.io_utils import ImportHelper
 from ...core.pipeline import RetargetSettings
 from ...core.presets import load_mapping_file
 from ...core.take import TakeError
-from ...takes import load_take
+from ...takes import body_count, load_take
 from ..bake_take import bake_take, take_display_name
 from .bake_settings import BakeOptionProps, copy_options, draw_bake_options, options_from
 from .mapping_table import table_overrides
+from .performers import MAX_BODY, other_performers
 from .preferences import FILTER_ITEMS
 from .properties import PRESET_ITEMS, ROOT_ITEMS, ROOT_SCALE_DESC, target_armature
 
@@ -34,6 +35,11 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper, BakeOptionP
     mirror: BoolProperty(name="Mirror", description="Swap the performer's left and right", default=False)
     root_scale: FloatProperty(name="Root Scale", default=0.0, min=0.0, soft_max=10.0, precision=3,
                               description=ROOT_SCALE_DESC)
+    body: IntProperty(name="Body", default=0, min=0, max=MAX_BODY,
+                      description="Which performer of a take with several (NTU, Kinectron) the target follows")
+    with_performers: BoolProperty(name="Other Performers", default=True,
+                                  description="Also bake each of the sidebar's other performers' bodies onto "
+                                              "their rigs (takes with several bodies)")
     scale: FloatProperty(name="BVH Scale", description="BVH only: metres per file unit (0: guess from the "
                          "figure's standing height)", default=0.0, min=0.0, precision=4)
 
@@ -49,7 +55,7 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper, BakeOptionP
         s = getattr(context.scene, "kinect_retarget", None)
         if s is not None:
             self.preset, self.filter, self.root, self.mirror = s.preset, s.filter, s.root, s.mirror
-            self.root_scale = s.root_scale
+            self.root_scale, self.body = s.root_scale, s.body
             copy_options(s, self)
             self.frame_start = context.scene.frame_start
         return super().invoke(context, event)
@@ -58,7 +64,8 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper, BakeOptionP
         layout = self.layout
         layout.use_property_split = True
         layout.use_property_decorate = False
-        for name in ("preset", "mapping_file", "filter", "root", "root_scale", "mirror", "fps", "frame_start"):
+        for name in ("preset", "mapping_file", "filter", "root", "root_scale", "mirror", "fps", "frame_start", "body",
+                     "with_performers"):
             layout.prop(self, name)
         draw_bake_options(layout, self)
 
@@ -66,8 +73,10 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper, BakeOptionP
         obj = target_armature(context)
         wm = context.window_manager
         try:
-            take = load_take(self.filepath, scale=self.scale or None)
+            take = load_take(self.filepath, scale=self.scale or None, body=self.body)
             take.metadata.setdefault("name", take_display_name(self.filepath))
+            others = [(o, b) for o, b in other_performers(context.scene) if o != obj and b < body_count(take)] \
+                if self.with_performers and body_count(take) > 1 else []
             # the sidebar's mapping table, then a mapping file on top
             s = getattr(context.scene, "kinect_retarget", None)
             table = (table_overrides(s) or {}) if s is not None else {}
@@ -85,6 +94,10 @@ class KINECT_RETARGET_OT_bake_take(bpy.types.Operator, ImportHelper, BakeOptionP
         try:
             bake_take(obj, take, preset=self.preset, overrides=overrides or None, settings=settings,
                       options=options, report=self.report, progress=lambda x: wm.progress_update(int(100 * x)))
+            for other, body in others:  # each other performer's body onto its own rig, its preset's mapping
+                each = load_take(self.filepath, body=body)
+                each.metadata.setdefault("name", f"{take_display_name(self.filepath)}_body{body}")
+                bake_take(other, each, preset=self.preset, settings=settings, options=options, report=self.report)
         except (TakeError, ValueError) as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}

@@ -7,6 +7,7 @@ from ..io.armature_probe import fallback_bones
 from ..live import live_runtime, record_countdown
 from ..live.osc_access import osc_host
 from .bake_settings import draw_bake_options
+from .performers import draw_performers
 from .preferences import get_preferences
 from .properties import target_armature
 
@@ -109,6 +110,7 @@ class KINECT_RETARGET_PT_target(_KinectPanel, bpy.types.Panel):
         if obj is not None and obj.get("kinect_retarget_calibration"):
             layout.label(text="Calibrated for this rig", icon="CHECKMARK")
         layout.prop(s, "preset")
+        draw_performers(layout, s)
 
 
 class KINECT_RETARGET_PT_mapping(_KinectPanel, bpy.types.Panel):

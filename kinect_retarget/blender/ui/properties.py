@@ -12,6 +12,7 @@ from ...core.presets import PRESET_NAMES
 from ...core.retarget import ROOT_MODES
 from ..live.record_countdown import COUNTDOWN_ITEMS
 from .bake_settings import BakeOptionProps
+from .performers import MAX_BODY, KinectRetargetPerformer, is_armature
 from .preferences import FILTER_ITEMS, SOURCE_ITEMS, get_preferences
 
 PRESET_ITEMS = [(p, p.replace("-", " ").title() if p != "auto" else "Auto", f"Bone-mapping preset: {p}")
@@ -19,10 +20,6 @@ PRESET_ITEMS = [(p, p.replace("-", " ").title() if p != "auto" else "Auto", f"Bo
 ROOT_ITEMS = [("xyz", "XYZ", "Root follows the performer in all axes"),
               ("xy", "Horizontal", "No vertical root motion"), ("none", "None", "Root stays in place")]
 assert tuple(r[0] for r in ROOT_ITEMS) == ROOT_MODES
-
-
-def _is_armature(self, obj) -> bool:
-    return obj.type == "ARMATURE"
 
 
 class KinectRetargetBoneMap(bpy.types.PropertyGroup):
@@ -52,8 +49,13 @@ class KinectRetargetSettings(bpy.types.PropertyGroup, BakeOptionProps):
     speed: FloatProperty(name="Speed", default=1.0, min=0.05, max=20.0, description="Playback speed")
     loop: BoolProperty(name="Loop", default=True, description="Play the take again when it ends")
     osc_port: IntProperty(name="Port", default=7000, min=1, max=65535)
-    armature: PointerProperty(name="Armature", type=bpy.types.Object, poll=_is_armature,
+    armature: PointerProperty(name="Armature", type=bpy.types.Object, poll=is_armature,
                               description="Rig to drive (empty: the active armature)")
+    body: IntProperty(name="Body", default=0, min=0, max=MAX_BODY,
+                      description="Which performer of the source drives the target (from 0: NTU's and "
+                                  "Kinectron's bodies in order, NI mate's user N is body N-1)")
+    performers: CollectionProperty(type=KinectRetargetPerformer)
+    performers_index: IntProperty(default=0)
     preset: EnumProperty(name="Preset", items=PRESET_ITEMS, default="auto")
     mapping: CollectionProperty(type=KinectRetargetBoneMap)
     mapping_index: IntProperty(default=0)
