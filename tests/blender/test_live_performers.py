@@ -137,3 +137,20 @@ def test_bake_take_bakes_each_body_onto_its_rig(two_rigs, shared_data, tmp_path)
     a_hand = np.array(alice.matrix_world @ alice.pose.bones["HandRight"].tail)
     b_hand = np.array(bob.matrix_world @ bob.pose.bones["HandRight"].tail)
     assert np.linalg.norm(a_hand - b_hand) > 0.3  # two different gestures, a metre apart
+
+
+def test_performer_rows_are_added_and_removed(two_rigs):
+    scene, (alice, bob), _ = two_rigs
+    s = scene.kinect_retarget
+    s.body = 2
+    bpy.ops.kinect_retarget.performer_add()
+    bpy.ops.kinect_retarget.performer_add()
+    assert [p.body for p in s.performers] == [3, 4]  # the next bodies nobody follows yet
+    assert bpy.ops.kinect_retarget.performer_remove(index=0) == {"FINISHED"}
+    assert [p.body for p in s.performers] == [4]
+    with pytest.raises(RuntimeError, match="no performer 5"):
+        bpy.ops.kinect_retarget.performer_remove(index=5)
+    s.performers[0].armature, s.performers[0].body = bob, 2
+    with pytest.raises(ValueError, match="its own body"):  # two rigs on one body: refused, nothing started
+        live.start_live(bpy.context, use_timer=False)
+    assert live.controller() is None

@@ -131,12 +131,12 @@ def start_live(context, source=None, settings: LiveSettings | None = None, overr
         body = scene_body if body is None else body
         followers = scene_followers if followers is None and source is None else followers
     followers = list(followers or [])
-    if source is None:
-        source, label = source_from_scene(context)
     if len({body, *(b for _, b in followers)}) != 1 + len(followers):
         raise ValueError("each performer drives one rig: give every target its own body")
     if len({obj.name, *(o.name for o, _ in followers)}) != 1 + len(followers):
         raise ValueError("each rig follows one performer: pick a different armature for every target")
+    if source is None:
+        source, label = source_from_scene(context)
     follower_controllers: list[LiveController] = []
     if followers or body:  # one source, several bodies: each rig's session sees its own body's frames
         fanout = BodyFanout(source)

@@ -27,6 +27,7 @@ class KINECT_RETARGET_UL_performers(bpy.types.UIList):
         row = layout.row(align=True)
         row.prop(item, "armature", text="")
         row.prop(item, "body")
+        row.operator("kinect_retarget.performer_remove", text="", icon="X", emboss=False).index = index
 
 
 class KINECT_RETARGET_OT_performer_add(bpy.types.Operator):
@@ -45,19 +46,19 @@ class KINECT_RETARGET_OT_performer_add(bpy.types.Operator):
 
 
 class KINECT_RETARGET_OT_performer_remove(bpy.types.Operator):
-    """Remove the selected performer"""
+    """Remove this performer (its rig keeps whatever was baked onto it)"""
     bl_idname = "kinect_retarget.performer_remove"
     bl_label = "Remove Performer"
-    bl_options = {"REGISTER", "UNDO"}
+    bl_options = {"REGISTER", "UNDO", "INTERNAL"}
 
-    @classmethod
-    def poll(cls, context):
-        return len(context.scene.kinect_retarget.performers) > 0
+    index: IntProperty(options={"HIDDEN"})
 
     def execute(self, context):
-        s = context.scene.kinect_retarget
-        s.performers.remove(s.performers_index)
-        s.performers_index = min(s.performers_index, len(s.performers) - 1)
+        performers = context.scene.kinect_retarget.performers
+        if not 0 <= self.index < len(performers):
+            self.report({"ERROR"}, f"no performer {self.index} in the list")
+            return {"CANCELLED"}
+        performers.remove(self.index)
         return {"FINISHED"}
 
 
@@ -65,11 +66,8 @@ def draw_performers(layout, s) -> None:
     """Under the target: its body, and the other performers' rigs."""
     layout.prop(s, "body", text="Follows Body")
     layout.label(text="Other Performers")
-    row = layout.row()
-    row.template_list("KINECT_RETARGET_UL_performers", "", s, "performers", s, "performers_index", rows=2)
-    col = row.column(align=True)
-    col.operator("kinect_retarget.performer_add", icon="ADD", text="")
-    col.operator("kinect_retarget.performer_remove", icon="REMOVE", text="")
+    layout.template_list("KINECT_RETARGET_UL_performers", "", s, "performers", s, "performers_index", rows=2)
+    layout.operator("kinect_retarget.performer_add", icon="ADD")
 
 
 def other_performers(scene) -> list[tuple[bpy.types.Object, int]]:
