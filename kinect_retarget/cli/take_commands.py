@@ -102,6 +102,8 @@ def performers(args, bodies_in_take: int) -> list[tuple[int, str | None]]:
     for b in bodies:
         if b >= bodies_in_take:
             raise ValueError(f"{args.take}: no body {b} (the take holds {bodies_in_take}, numbered from 0)")
+    if not args.rig and names:  # (one body too: the generated rig would ignore the name)
+        raise ValueError("--armature names armatures in --rig; without --rig each body gets a generated rig")
     if len(bodies) == 1:
         if len(names) > 1:
             raise ValueError("several --armature need as many --body (one rig per performer)")
@@ -109,8 +111,6 @@ def performers(args, bodies_in_take: int) -> list[tuple[int, str | None]]:
     if args.rig and len(names) != len(bodies):
         raise ValueError(f"{len(bodies)} bodies need {len(bodies)} --armature names in --rig, paired in order "
                          f"(got {len(names)})")
-    if not args.rig and names:
-        raise ValueError("--armature names armatures in --rig; without --rig each body gets a generated rig")
     return list(zip(bodies, names or [None] * len(bodies)))
 
 

@@ -98,3 +98,6 @@ def test_bad_performer_arguments_are_named(tmp_path, two_person_take, shared_dat
     rc, _, err = _cli("bake", shared_data / "kinect_v2" / "Ges01_wavehand.csv", "--out", tmp_path / "x.blend",
                       "--body", 1)
     assert rc == 2 and "no body 1" in err
+    rc, _, err = _cli("bake", shared_data / "kinect_v2" / "Ges01_wavehand.csv", "--out", tmp_path / "x.blend",
+                      "--armature", "Nope")  # one body, no --rig: the name would be ignored
+    assert rc == 2 and "without --rig" in err
