@@ -1,6 +1,6 @@
 """Reader speed on 10,000-frame files (goal: well under 0.1 s where the format allows). Prints figures only.
 
-    PYTHONPATH=. .venv/bin/python tests/takes/bench_readers.py
+    PYTHONPATH=. .venv/bin/python benchmarks/bench_readers.py
 
 Each file is real data tiled to 10,000 frames (timestamps continued), written to a temporary folder.
 """

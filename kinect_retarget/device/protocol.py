@@ -1,6 +1,6 @@
 """Kinect v1 wire protocol: USB ids, the GM/RB camera command format, register sequences, iso packet headers.
 
-Pure bytes in, bytes out: no USB I/O here (camera.py does that), so the same code serves the real device, the
+Pure bytes in, bytes out: no USB I/O here (kinect_camera.py does that), so the same code serves the real device, the
 emulated one and offline dump replay. Facts follow libfreenect's protocol notes (docs/usb_driver.md).
 """
 from __future__ import annotations
