@@ -12,6 +12,7 @@ from bpy.utils import escape_identifier
 
 from ..core.bake_options import BakeOptions, take_range
 from ..core.key_reduction import Reduction, reduce_keys
+from ..core.foot_lock import FeetReport, FootLock, key_rate
 from ..core.kinect_rig_layout import median_segment_lengths
 from ..core.pipeline import BakedMotion, RetargetPipeline, RetargetSettings
 from ..core.presets import build_mapping, mapping_problems
@@ -37,6 +38,7 @@ class BakeResult:
     frame_range: tuple[int, int]
     reduction: Reduction | None = None
     strip: str | None = None
+    feet: FeetReport | None = None
 
 
 def _no_report(level: set, message: str) -> None:
@@ -126,6 +128,7 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
     if not on_samples:
         motion = resample_motion(motion, take.times[motion.samples] - take.times[0], rate, settings.frame_start,
                                  options.step)
+    feet = FootLock(pipeline.retargeter).apply(motion, options.feet, key_rate(motion))
     if progress:
         progress(0.3)
     extra = []
@@ -161,10 +164,10 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
                      + (f"; key reduction removed {reduction.removed} keys (max error {reduction.max_deg:.3f}°, "
                         f"{reduction.max_mm:.3f} mm)" if reduction else "")
                      + (f"; left alone (the take has no position for their joints): {', '.join(skipped)}"
-                        if skipped else "") + root_note + _reading(take.metadata))
+                        if skipped else "") + root_note + f"; {feet.summary()}" + _reading(take.metadata))
     if progress:
         progress(1.0)
-    return BakeResult(action, motion, used, (first, last), reduction, strip)
+    return BakeResult(action, motion, used, (first, last), reduction, strip, feet)
 
 
 def _reading(meta: dict) -> str:

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..core.bake_options import HAND_MODES, RANGE_UNITS, BakeOptions
 from ..core.filters import FILTERS
+from ..core.foot_lock import FEET_MODES
 from ..core.presets import PRESET_NAMES
 from ..core.retarget import ROOT_MODES
 from ..takes import body_count, load_take
@@ -70,6 +71,9 @@ def add_bake_option_args(p) -> None:
     g.add_argument("--hands", choices=HAND_MODES, default="auto",
                    help="Kinect v2 hands (thumb roll, hand-tip bend, hand-state curls) on rigs with finger bones; "
                         "auto: on for v2 takes")
+    g.add_argument("--feet", choices=FEET_MODES, default="lock",
+                   help="lock: planted feet pinned where they land (two-bone IK) and kept above the floor; "
+                        "floor: only kept above the floor; off")
     g.add_argument("--root-motion", action="store_true",
                    help="put the performer's horizontal travel on the rig's root bone, the hips relative to it "
                         "(game engines; the pose in the world is unchanged)")
@@ -118,7 +122,7 @@ def bake_options_from_args(args) -> BakeOptions:
     return BakeOptions(range_start=args.take_start, range_end=args.take_end, range_unit=args.range_unit,
                        step=args.step, reduce=args.reduce, tolerance_deg=args.tolerance_deg,
                        tolerance_mm=args.tolerance_mm, into_current=args.into_current, push_nla=args.nla,
-                       set_scene_fps=args.set_scene_fps, extend_scene_range=args.extend_range, hands=args.hands,
+                       set_scene_fps=args.set_scene_fps, extend_scene_range=args.extend_range, hands=args.hands, feet=args.feet,
                        root_motion=args.root_motion or args.root_motion_facing,
                        root_motion_facing=args.root_motion_facing, root_bone=args.root_bone)
 

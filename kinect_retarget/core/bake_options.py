@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .foot_lock import FEET_MODES
 from .take import Take, TakeError
 
 RANGE_UNITS = ("seconds", "frames")
@@ -27,6 +28,8 @@ class BakeOptions:
     set_scene_fps: bool = False        # run the scene at the bake's rate
     extend_scene_range: bool = False   # grow the scene's frame range to hold the keys (never shrinks it)
     hands: str = "auto"                # thumb roll, hand-tip bend, hand-state curls on rigs with fingers
+    feet: str = "lock"                 # lock: planted feet pinned and kept above the floor; floor: only the
+                                       # floor; off (core/foot_lock.py)
     root_motion: bool = False          # the performer's horizontal travel on the rig's root bone (game engines)
     root_motion_facing: bool = False   # ... and their heading about the up axis
     root_bone: str | None = None       # the bone to carry it; None = the top ancestor of the hips bone
@@ -38,6 +41,8 @@ class BakeOptions:
             raise ValueError(f"unknown range unit {self.range_unit!r} (choose from {', '.join(RANGE_UNITS)})")
         if self.hands not in HAND_MODES:
             raise ValueError(f"unknown hands mode {self.hands!r} (choose from {', '.join(HAND_MODES)})")
+        if self.feet not in FEET_MODES:
+            raise ValueError(f"unknown feet mode {self.feet!r} (choose from {', '.join(FEET_MODES)})")
         if self.step < 1:
             raise ValueError(f"key step must be at least 1 frame, got {self.step}")
         if self.reduce and not (self.tolerance_deg > 0 and self.tolerance_mm > 0):

@@ -96,6 +96,22 @@ def target_joint_positions(skeleton: Skeleton, rig: TargetRig, mapped: list[Mapp
     return pos
 
 
+def rest_leg_length(rig: TargetRig, mapped: list[MappedBone]) -> float | None:
+    """The rig's hip->knee + knee->ankle (mean of both sides) from the heads of the thigh, shin and foot bones:
+    a limb bone's head sits at its joint even where twist bones split the limb (MakeHuman's upperleg01 ends a
+    fifth of the way to the knee, so its tail is no knee)."""
+    by_joint = {m.tail_name: m.index for m in mapped}
+    lengths = []
+    for side in ("Left", "Right"):
+        thigh, shin, foot = (by_joint.get(j + side) for j in ("Knee", "Ankle", "Foot"))
+        if thigh is None or shin is None:
+            continue
+        ankle = rig.heads[foot] if foot is not None else rig.tails[shin]
+        lengths.append(float(np.linalg.norm(rig.heads[shin] - rig.heads[thigh])
+                             + np.linalg.norm(ankle - rig.heads[shin])))
+    return float(np.mean(lengths)) if lengths else None
+
+
 def leg_length(get) -> float | None:
     """Mean of left and right hip->knee + knee->ankle lengths (median over frames), or None."""
     lengths = []
@@ -132,7 +148,7 @@ class Retargeter:
         self.world_up = rig.object_rotation.T @ np.array([0.0, 0.0, 1.0])
         tpos = target_joint_positions(skeleton, rig, self.mapped, self.world_up)
         get_t = _drop_unknown(resolver(skeleton.joints, tpos))
-        self.target_leg = leg_length(get_t)
+        self.target_leg = rest_leg_length(rig, self.mapped) or leg_length(get_t)
         # the target's rest frame O_t per bone (eq. 11 uses O_tᵀ · R_rest(b))
         self.rest_frames = np.empty((len(self.mapped), 3, 3))
         for k, m in enumerate(self.mapped):

@@ -15,7 +15,7 @@ BVH = Path(__file__).resolve().parents[1] / "data" / "bvh" / "video2bvh_dance.bv
 def _bake(tmp_path, *extra):
     out = tmp_path / "dance.blend"
     r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(BVH), "--out", str(out),
-                        "--filter", "none", *extra], capture_output=True, text=True)
+                        "--filter", "none", "--feet", "off", *extra], capture_output=True, text=True)
     return r, out
 
 
@@ -68,7 +68,8 @@ def test_blender_bvh_export_reads_back_as_the_same_figure(tmp_path):
     src = BVH.parent / "mocapbank_sit_down.bvh"
     out = tmp_path / "exported.bvh"
     r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(src), "--out", str(out), "--filter",
-                        "none", "--take-end", "59", "--range-unit", "frames"], capture_output=True, text=True)
+                        "none", "--feet", "off", "--take-end", "59", "--range-unit", "frames"],
+                       capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     back = bvh.read(out, min_range=None)
     meta = back.metadata

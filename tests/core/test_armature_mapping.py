@@ -4,12 +4,9 @@ the limbs, fingers or none, face bones, an A-pose and a T-pose; then a take bake
 performer."""
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
 
-from kinect_retarget.assets import MAKEHUMAN_DIR
 from kinect_retarget.core.armature_mapping import structure_mapping_for, twist_leaves
 from kinect_retarget.core.conventions import kinect_to_blender
 from kinect_retarget.core.kinect_rig_layout import generated_rig, typical_segment_lengths
@@ -21,27 +18,11 @@ from kinect_retarget.core.skeletons import KINECT_V1, KINECT_V2
 from kinect_retarget.core.structure_mapping import StructureError
 from kinect_retarget.core.target_rig import evaluate_pose
 from kinect_retarget.takes import load_take
-from tests.rigs.humanoid_rigs import Rig, build, from_target, renamed
+from tests.rigs.humanoid_rigs import Rig, build, from_target, makehuman_rig, renamed
 from tests.rigs.layouts import LAYOUTS
 
 VARIANTS = {"t-pose": {}, "a-pose+face": {"a_pose_deg": 40, "face": True}, "no-fingers": {"fingers": False},
             "a-pose-30-no-fingers": {"a_pose_deg": 30, "fingers": False}}
-
-
-def makehuman_rig() -> Rig:
-    """MakeHuman's default skeleton (163 bones, A-pose, twist halves inside the limbs, fingers, face)."""
-    skel = json.loads((MAKEHUMAN_DIR / "default.mhskel").read_text())
-    verts = np.array([[float(x) for x in line.split()[1:4]] for line in open(MAKEHUMAN_DIR / "base.obj")
-                      if line.startswith("v ")])
-    joints = {n: verts[i].mean(axis=0) for n, i in skel["joints"].items()}
-
-    def blender(p):  # decimetres, Y-up -> metres, Z-up, facing -Y
-        return np.array((0.1 * p[0], -0.1 * p[2], 0.1 * p[1]))
-    names = list(skel["bones"])
-    bones = skel["bones"]
-    return Rig(names, np.array([names.index(bones[n]["parent"]) if bones[n]["parent"] else -1 for n in names]),
-               np.array([blender(joints[bones[n]["head"]]) for n in names]),
-               np.array([blender(joints[bones[n]["tail"]]) for n in names]))
 
 
 def _by_structure(rig: Rig, seed: int = 11) -> dict[str, str]:

@@ -3,10 +3,12 @@ a short layout per rig family: bone-name lists placed on one body's landmarks. V
 inside the limbs, fingers, face bones, an A-pose, and every name replaced by a seeded random string."""
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass, replace
 
 import numpy as np
 
+from kinect_retarget.assets import MAKEHUMAN_DIR
 from kinect_retarget.core.target_rig import TargetRig
 
 
@@ -135,3 +137,19 @@ def build(layout: dict, a_pose_deg: float = 0.0, fingers: bool = True, face: boo
         foot = b.bone(nm("foot"), shin, _side(ANKLE, x), _side(BALL, x))
         b.bone(nm("toe"), foot, _side(BALL, x), _side(TOE, x))
     return b.rig()
+
+
+def makehuman_rig() -> Rig:
+    """MakeHuman's default skeleton (163 bones, A-pose, twist halves inside the limbs, fingers, face)."""
+    skel = json.loads((MAKEHUMAN_DIR / "default.mhskel").read_text())
+    verts = np.array([[float(x) for x in line.split()[1:4]] for line in open(MAKEHUMAN_DIR / "base.obj")
+                      if line.startswith("v ")])
+    joints = {n: verts[i].mean(axis=0) for n, i in skel["joints"].items()}
+
+    def blender(p):  # decimetres, Y-up -> metres, Z-up, facing -Y
+        return np.array((0.1 * p[0], -0.1 * p[2], 0.1 * p[1]))
+    names = list(skel["bones"])
+    bones = skel["bones"]
+    return Rig(names, np.array([names.index(bones[n]["parent"]) if bones[n]["parent"] else -1 for n in names]),
+               np.array([blender(joints[bones[n]["head"]]) for n in names]),
+               np.array([blender(joints[bones[n]["tail"]]) for n in names]))

@@ -17,6 +17,10 @@ HAND_ITEMS = [("auto", "Auto", "Hands for takes with Kinect v2's hand joints, no
               ("on", "On", "Roll the hand from the thumb, bend the fingers toward the hand tip, curl them from "
                            "the hand states (open, fist, lasso)"),
               ("off", "Off", "Leave the finger bones and the hand's roll alone")]
+FEET_ITEMS = [("lock", "Lock Planted Feet", "Pin each foot where it lands while planted (two-bone IK on the "
+               "leg, eased in and out) and keep the feet above the floor"),
+              ("floor", "Floor Only", "Keep the feet at or above the floor, nothing else"),
+              ("off", "Off", "Leave the feet as the performer's joints put them")]
 RANGE_UNIT_ITEMS = [("seconds", "Seconds", "Take range in seconds from the take's start"),
                     ("frames", "Take Frames", "Take range in the take's own frames, counted from 0")]
 
@@ -46,6 +50,8 @@ class BakeOptionProps:
     destination: EnumProperty(name="Keys Into", items=DESTINATION_ITEMS, default="NEW")
     hands: EnumProperty(name="Hands", items=HAND_ITEMS, default="auto",
                         description="Kinect v2 hands on rigs with finger bones (Rigify, Mixamo, UE Mannequin)")
+    feet: EnumProperty(name="Feet", items=FEET_ITEMS, default="lock",
+                       description="Planted feet and the floor (bakes only; live leaves the feet as tracked)")
     root_motion: BoolProperty(name="Root Motion", default=False,
                               description="Put the performer's horizontal travel on the rig's root bone, the hips "
                                           "relative to it (game engines); the pose in the world is unchanged")
@@ -63,7 +69,7 @@ def options_from(owner) -> BakeOptions:
                        tolerance_deg=owner.tolerance_deg, tolerance_mm=owner.tolerance_mm,
                        into_current=owner.destination == "CURRENT", push_nla=owner.destination == "NLA",
                        set_scene_fps=owner.set_scene_fps, extend_scene_range=owner.extend_scene_range,
-                       hands=owner.hands,
+                       hands=owner.hands, feet=owner.feet,
                        root_motion=owner.root_motion, root_motion_facing=owner.root_motion_facing,
                        root_bone=owner.root_bone or None)
 
@@ -72,9 +78,9 @@ def recording_bake_options(scene) -> BakeOptions:
     """The sidebar's options for the bake when a recording stops: its keys land on the frames live showed
     them (no take range, no resampling), and the scene's rate is left alone."""
     if scene is None or getattr(scene, "kinect_retarget", None) is None:
-        return BakeOptions(keys_on_samples=True)
+        return BakeOptions(keys_on_samples=True, feet="off")
     return replace(options_from(scene.kinect_retarget), range_start=None, range_end=None, set_scene_fps=False,
-                   keys_on_samples=True)
+                   keys_on_samples=True, feet="off")
 
 
 def copy_options(src, dst) -> None:
@@ -102,6 +108,7 @@ def draw_bake_options(layout, owner) -> None:
     sub.prop(owner, "tolerance_mm")
     layout.prop(owner, "destination")
     layout.prop(owner, "hands")
+    layout.prop(owner, "feet")
     col = layout.column(heading="Root Motion")
     col.prop(owner, "root_motion", text="Travel on Root Bone")
     sub = col.column(align=True)

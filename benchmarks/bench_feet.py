@@ -1,0 +1,84 @@
+"""Planted feet (issue 16): foot slide during detected contacts and floor penetration before and after the
+feet pass (core/foot_lock.py), and how much the limbs' directions change where it does not act, on every
+sample take with walking, hopping or jumping and on the Kinect v2 gestures, baked onto the generated Kinect
+rig and onto MakeHuman's default skeleton (a real third-party rig with twist bones).
+
+    .venv/bin/python benchmarks/bench_feet.py
+
+Without Blender: the solver and its Blender-like forward kinematics (the bpy tests check Blender agrees).
+Slide: the ankle's horizontal distance from its contact's mean place, over every contact frame (median and
+95th percentile, cm), measured on the rig's forward kinematics before and after. Below floor: the deepest
+ankle under its rest height over the floor (cm). Directions: the largest change (degrees) of any mapped bone's
+direction on frames the pass leaves alone (legs outside contacts, their eases and floor fixes; every other bone
+on every frame). Body: the one vertical shift that stands planted feet on the floor. Prints figures only.
+"""
+from __future__ import annotations
+
+import copy
+
+import _common
+import numpy as np
+
+from kinect_retarget.core.foot_lock import FootLock
+from kinect_retarget.core.kinect_rig_layout import generated_mapping, generated_rig, median_segment_lengths
+from kinect_retarget.core.pipeline import RetargetPipeline, RetargetSettings
+from kinect_retarget.core.presets import PRESETS
+from kinect_retarget.core.target_rig import evaluate_pose
+from kinect_retarget.takes import load_take
+from tests.rigs.humanoid_rigs import makehuman_rig
+
+TAKES = ["kinect_v1_cmu_131_01_walk", "kinect_v1_cmu_131_02_walk", "kinect_v1_cmu_131_03_hop",
+         "kinect_v1_cmu_01_01_jumps"] + [f"kinect_v2_ges0{i}_{n}" for i, n in enumerate(
+             ("wavehand", "balancinghands", "drawlines", "comehere", "demopoint", "chickenwing"), start=1)]
+
+
+def directions(rig, motion):
+    idx = np.array([rig.index(b) for b in motion.bone_names])
+    root = rig.index(motion.root_bone) if motion.root_bone else None
+    return evaluate_pose(rig, idx, motion.quats, root, motion.root_location)[:, idx][..., :3, 1]
+
+
+def measure(take, rig, mapping):
+    pipe = RetargetPipeline(take.skeleton, rig, mapping, RetargetSettings())
+    before = pipe.process_take(take)
+    after = copy.deepcopy(before)
+    report = FootLock(pipe.retargeter).apply(after, "lock", take.rate)
+    d0, d1 = directions(rig, before), directions(rig, after)
+    angle = np.degrees(np.arccos(np.clip(np.sum(d0 * d1, -1), -1, 1)))     # (F, M)
+    leave = np.ones_like(angle, bool)
+    legs = {side: bones for side, bones in FootLock(pipe.retargeter).legs.items()}
+    for leg in report.legs:
+        for m in legs[leg.side]:
+            if m is not None and m.bone in after.bone_names:
+                leave[leg.changed, after.bone_names.index(m.bone)] = False
+    return report, float(angle[leave].max()) if leave.any() else 0.0
+
+
+def main() -> None:
+    rigs = {"generated": None, "makehuman": makehuman_rig().target("MakeHuman")}
+    print(f"{'take':<36} {'rig':<10} {'side':<5} {'contacts':>8} {'slide before':>14} {'slide after':>13} "
+          f"{'below floor':>13} {'body':>7} {'dir. change':>11}")
+    print(f"{'':<36} {'':<10} {'':<5} {'(frames)':>8} {'med/p95 cm':>14} {'med/p95 cm':>13} {'cm bef/aft':>13} "
+          f"{'cm':>7} {'deg':>11}")
+    worst = []
+    for name in TAKES:
+        take = load_take(_common.SAMPLE_TAKES / f"{name}.krtake")
+        for rig_name, rig in rigs.items():
+            if rig is None:
+                target, mapping = generated_rig(take.skeleton, median_segment_lengths(take)), generated_mapping(
+                    take.skeleton)
+            else:
+                target, mapping = rig, PRESETS["makehuman"]
+            report, change = measure(take, target, mapping)
+            for leg in report.legs:
+                worst.append(leg.slide_after_cm[1])
+                print(f"{name:<36} {rig_name:<10} {leg.side:<5} {leg.contacts:>3} ({leg.contact_frames:>4}) "
+                      f"{leg.slide_before_cm[0]:>6.2f}/{leg.slide_before_cm[1]:<6.2f} "
+                      f"{leg.slide_after_cm[0]:>5.2f}/{leg.slide_after_cm[1]:<6.2f} "
+                      f"{leg.below_floor_before_cm:>5.1f}/{leg.below_floor_after_cm:<6.2f} "
+                      f"{report.height_shift_cm:>7.1f} {change:>11.2e}")
+    print(f"worst slide p95 after: {max(worst):.3f} cm (goal <= 1 cm)")
+
+
+if __name__ == "__main__":
+    main()
