@@ -140,4 +140,6 @@ def _bake_one(obj, take: Take, generated: bool, preset: str, overrides, settings
                        max_error_mm=round(result.reduction.max_mm, 4))
     if result.strip:
         summary["nla_strip"] = result.strip
+    if result.feet is not None:
+        summary["feet"] = result.feet.summary()
     return summary, result

@@ -1,0 +1,90 @@
+"""Feet and root motion in Blender (issue 16): an Unreal-Mannequin-named armature built from its bone list,
+a hopping take baked with root motion (the world pose equals the in-place bake, the root bone travels) and
+with the feet locked (Blender's own evaluation keeps a planted ankle in place and above its rest height);
+the CLI's --feet and --root-motion."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+
+from kinect_retarget.core.bake_options import BakeOptions
+from kinect_retarget.core.foot_contacts import intervals
+from kinect_retarget.core.pipeline import RetargetSettings
+from kinect_retarget.takes import load_take
+from tests.conftest import SAMPLE_TAKES
+from tests.rigs.humanoid_rigs import build
+from tests.rigs.layouts import LAYOUTS
+
+HOP = SAMPLE_TAKES / "kinect_v1_cmu_131_03_hop.krtake"
+
+
+def _armature(bpy, name="UE4"):
+    from kinect_retarget.blender.mesh_autorig import armature_edit
+    rig = build(LAYOUTS["ue4-mannequin"], a_pose_deg=30)
+    arm = bpy.data.armatures.new(name)
+    obj = bpy.data.objects.new(name, arm)
+    bpy.context.scene.collection.objects.link(obj)
+    with armature_edit(bpy.context, obj) as data:
+        for n, h, t in zip(rig.names, rig.heads, rig.tails):
+            b = data.edit_bones.new(n)
+            b.head, b.tail = h.tolist(), t.tolist()
+        for n, p in zip(rig.names, rig.parents):
+            if p >= 0:
+                data.edit_bones[n].parent = data.edit_bones[rig.names[p]]
+    return obj
+
+
+def _world(bpy, obj, frames):
+    out = []
+    for f in frames:
+        bpy.context.scene.frame_set(int(f))
+        out.append([np.array(obj.matrix_world @ pb.matrix) for pb in obj.pose.bones])
+    return np.array(out)
+
+
+def test_root_motion_and_locked_feet_as_blender_evaluates_them(bpy_empty):
+    from kinect_retarget.blender.bake_take import bake_take
+    bpy = bpy_empty
+    obj = _armature(bpy)
+    take = load_take(HOP)
+    settings = RetargetSettings(fps=take.rate)
+    plain = bake_take(obj, take, settings=settings, options=BakeOptions(feet="off"))
+    assert plain.preset == "ue4-mannequin"
+    frames = plain.motion.frames[::15]
+    in_place = _world(bpy, obj, frames)
+    moved = bake_take(obj, take, settings=settings, options=BakeOptions(feet="off", root_motion=True))
+    travel = _world(bpy, obj, frames)
+    root = obj.pose.bones.find("root")
+    others = [i for i in range(len(obj.pose.bones)) if i != root]
+    np.testing.assert_allclose(travel[:, others], in_place[:, others], atol=2e-5)  # the same pose in the world
+    assert np.linalg.norm(travel[-1, root, :2, 3] - travel[0, root, :2, 3]) > 0.3    # the root travels
+    np.testing.assert_allclose(travel[:, root, 2, 3], 0.0, atol=1e-6)                # on the floor
+    assert list(moved.motion.extras["locations"]) == ["root"]
+    locked = bake_take(obj, take, settings=settings)  # feet lock by default
+    assert locked.feet is not None and locked.feet.mode == "lock"
+    leg = next(g for g in locked.feet.legs if g.side == "Left")
+    foot = obj.pose.bones.find("foot_l")
+    rest_height = obj.data.bones["foot_l"].head_local[2]
+    for a, b in intervals(leg.contact)[:2]:
+        ankle = _world(bpy, obj, locked.motion.frames[a:b + 1])[:, foot, :3, 3]
+        assert np.linalg.norm(ankle[:, :2] - ankle[:, :2].mean(axis=0), axis=-1).max() < 0.01
+        assert ankle[:, 2].min() >= rest_height - 1e-4
+
+
+def test_cli_bake_with_feet_and_root_motion(bpy_empty, tmp_path):
+    bpy = bpy_empty
+    _armature(bpy)
+    rig_path = tmp_path / "ue4.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(rig_path))
+    out = tmp_path / "out.blend"
+    r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(HOP), "--rig", str(rig_path), "--out",
+                        str(out), "--feet", "floor", "--root-motion-facing", "--take-end", "2"],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    summary = json.loads(r.stdout.strip().splitlines()[-1])
+    text = json.dumps(summary)
+    assert "feet (floor" in text and "root motion on 'root' with facing" in text
+    bad = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(HOP), "--out", str(tmp_path / "x.blend"),
+                          "--root-motion"], capture_output=True, text=True, timeout=300)
+    assert bad.returncode != 0 and "root bone above the hips" in bad.stderr  # the generated rig has none
