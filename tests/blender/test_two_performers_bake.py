@@ -49,6 +49,7 @@ def test_body_all_bakes_each_body_onto_a_generated_rig(bpy_empty, shared_data, t
     bpy = bpy_empty
     out = tmp_path / "duo.blend"
     rc, stdout, stderr = _cli("bake", two_person_take, "--out", out, "--body", "all", "--filter", "none",
+                              "--feet", "off",  # limb directions as the solver gives them
                               "--fps", 30)
     assert rc == 0, stderr
     result = json.loads(stdout.strip().splitlines()[-1])
@@ -75,7 +76,7 @@ def test_armature_body_pairs_bake_onto_the_rigs_of_a_file(bpy_empty, shared_data
     # pairs in order: Bob dances body 1, Alice body 0
     rc, stdout, stderr = _cli("bake", two_person_take, "--out", out, "--rig", rigs, "--armature", "Bob",
                               "--body", 1, "--armature", "Alice", "--body", 0, "--filter", "none",
-                              "--preset", "kinect", "--set-scene-fps", "--fps", 30)
+                              "--preset", "kinect", "--set-scene-fps", "--fps", 30, "--feet", "off")
     assert rc == 0, stderr
     result = json.loads(stdout.strip().splitlines()[-1])
     assert [(p["armature"], p["body"]) for p in result["performers"]] == [("Bob", 1), ("Alice", 0)]
