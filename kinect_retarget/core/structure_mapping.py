@@ -292,13 +292,12 @@ class _Mapper:
         if pelvis is None:
             raise StructureError("no node where a spine and two legs meet (no pelvis with three large branches)")
         big = self._branches(pelvis, BIG_BRANCH)
-        chests = {b: self._descend_to_fork(b, NECK_BRANCH, 3, ARM_BRANCH) for b in big}
-        spines = [b for b in big if chests[b] is not None]
+        chests = {b: c for b in big if (c := self._descend_to_fork(b, NECK_BRANCH, 3, ARM_BRANCH)) is not None}
+        spines = list(chests)   # the branches with a chest, in `big`'s order
         if not spines:
             raise StructureError(f"no chest above {self.names[pelvis]!r}: no node where two arms and a neck meet")
         spine = max(spines, key=lambda b: self._extent(pelvis, b))
         chest = chests[spine]
-        assert chest is not None   # spines holds only branches with a chest
         legs = [b for b in big if b != spine]
         if len(legs) < 2:
             raise StructureError(f"{self.names[pelvis]!r} has one leg branch; a humanoid needs two")
