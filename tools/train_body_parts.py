@@ -12,7 +12,8 @@ pitched -5..20 degrees; the sensor's projector shadow, edge dropouts, disparity 
 (render.kinect_artifacts). Labels: body_parts.PARTS from the mesh's skin weights (sim/body_part_labels.py). Each
 image's person cells on the tracker's 4-pixel grid are sampled, and a pool of depth-difference features is
 evaluated on them; scikit-learn's RandomForestClassifier picks from the pool at every split; the trees are
-flattened into numpy arrays (part_forest.PartForest). Seeded: the same arguments give the same file.
+flattened into numpy arrays (part_forest.PartForest). Seeded: the same arguments give the same trees (only
+the times recorded in the recipe differ).
 """
 from __future__ import annotations
 
