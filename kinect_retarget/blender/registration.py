@@ -7,14 +7,14 @@ import bpy
 
 from .live import live_runtime, record_countdown, usb_service
 from .ui import (autorig_operator, bake_operator, clip_operators, live_operators, mapping_table, menus, panels,
-                 performers, preferences, properties, takes_list, usb_panel)
+                 performers, preferences, properties, source_overlay, takes_list, usb_panel)
 
 CLASSES = (*bake_operator.CLASSES, *preferences.CLASSES, *performers.CLASSES, *properties.CLASSES,
            *live_operators.CLASSES, *mapping_table.CLASSES, *panels.CLASSES, *takes_list.CLASSES, *usb_panel.CLASSES,
            *autorig_operator.CLASSES, *clip_operators.CLASSES, *menus.CLASSES)
 # modules with register_extra()/unregister_extra(), in order
 HOOKS = (properties, live_runtime, usb_service, usb_panel, autorig_operator, clip_operators, menus,
-         record_countdown)
+         record_countdown, source_overlay)
 
 _done = {"classes": 0, "hooks": 0}   # how far register() got, so unregister() undoes exactly that
 

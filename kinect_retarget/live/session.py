@@ -40,6 +40,7 @@ class LiveSession:
         self.error: str | None = None
         self.running = False
         self.last_pose = None
+        self.last_frame = None  # the newest frame with a tracked joint (the 3D View's source skeleton)
         self.last_tracked_joints = 0
         self._t0_source: float | None = None   # source clock of the first frame
         self._t0_session = 0.0                 # session clock of the first frame
@@ -127,7 +128,7 @@ class LiveSession:
             self.last_tracked_joints = tracked
             if last_tracked is not None:
                 self.stats.superseded += 1
-            last_tracked = frame
+            last_tracked = self.last_frame = frame
         if lost:
             self.stop(lost)
             return False

@@ -9,6 +9,7 @@ from ..live.osc_access import osc_host
 from .bake_settings import draw_bake_options
 from .performers import draw_performers
 from .preferences import get_preferences
+from .source_overlay import draw_settings as draw_source_settings
 from .properties import target_armature
 
 
@@ -44,6 +45,7 @@ class KINECT_RETARGET_PT_main(_KinectPanel, bpy.types.Panel):
         else:
             col.label(text="Skeletons from the depth tracker (devices: USB Kinect below)", icon="INFO")
         self._draw_status(box, st)
+        draw_source_settings(layout, s)
 
         col = layout.column(align=True)
         row = col.row(align=True)

@@ -5,8 +5,8 @@ Live status is runtime state (blender/live/live_runtime.py), not stored here, so
 from __future__ import annotations
 
 import bpy
-from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, IntProperty,
-                       PointerProperty, StringProperty)
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
+                       IntProperty, PointerProperty, StringProperty)
 
 from ...core.presets import PRESET_NAMES
 from ...core.retarget import ROOT_MODES
@@ -20,6 +20,13 @@ PRESET_ITEMS = [(p, p.replace("-", " ").title() if p != "auto" else "Auto", f"Bo
 ROOT_ITEMS = [("xyz", "XYZ", "Root follows the performer in all axes"),
               ("xy", "Horizontal", "No vertical root motion"), ("none", "None", "Root stays in place")]
 assert tuple(r[0] for r in ROOT_ITEMS) == ROOT_MODES
+
+
+def _redraw_views(self, context) -> None:
+    screen = getattr(context, "screen", None)
+    for area in screen.areas if screen is not None else ():
+        if area.type == "VIEW_3D":
+            area.tag_redraw()
 
 
 class KinectRetargetBoneMap(bpy.types.PropertyGroup):
@@ -55,6 +62,13 @@ class KinectRetargetSettings(bpy.types.PropertyGroup, BakeOptionProps):
                       description="Which performer of the source drives the target (from 0: NTU's and "
                                   "Kinectron's bodies in order, NI mate's user N is body N-1)")
     performers: CollectionProperty(type=KinectRetargetPerformer)
+    show_source: BoolProperty(name="Show Source Skeleton", default=False, update=_redraw_views,
+                              description="Draw the performer's skeleton as the source delivers it beside each "
+                                          "character (live, or the take at the current frame): green joints "
+                                          "tracked, amber inferred")
+    source_offset: FloatVectorProperty(name="Source Offset", size=3, subtype="TRANSLATION", unit="LENGTH",
+                                       default=(1.0, 0.0, 0.0), update=_redraw_views,
+                                       description="Where the source skeleton stands, from the character's origin")
     performers_index: IntProperty(default=0)
     preset: EnumProperty(name="Preset", items=PRESET_ITEMS, default="auto")
     mapping: CollectionProperty(type=KinectRetargetBoneMap)
