@@ -1,6 +1,7 @@
 """Rigs whose bones hang from constraint-driven parents (issue 15): the probe learns the relations on an
 armature copy, numpy solves every frame, and what it cannot learn Blender evaluates per frame (fallback)."""
 import numpy as np
+import pytest
 
 from kinect_retarget.core.bake_options import BakeOptions
 from kinect_retarget.core.pipeline import RetargetSettings
@@ -119,3 +120,18 @@ def test_bake_into_the_current_action_keeps_its_other_channels_playing(bpy_empty
     assert len(bpy.data.actions) == 1   # the probe's copy of the Action is gone
     assert res.motion.extras["parent_model"].fallback_names == ["MCH-knee"]
     assert _evaluated_error(bpy, obj, res.motion).max() < 0.001
+
+
+def test_a_probe_that_fails_while_preparing_leaves_no_copy_behind(bpy_empty):
+    from kinect_retarget.blender.bake_take import new_generated_rig
+    from kinect_retarget.blender.io.armature_probe import ArmatureEvaluator
+    bpy = bpy_empty
+    take = load_take(SAMPLES / "kinect_v2_ges03_drawlines.krtake").slice(slice(0, 5))
+    obj = new_generated_rig(bpy.context.scene, take)
+    before = (len(bpy.data.scenes), len(bpy.data.objects), len(bpy.data.armatures), len(bpy.data.actions))
+    with pytest.raises(KeyError):
+        ArmatureEvaluator(obj, ["NoSuchBone"])   # fails after the copy and its scene exist
+    assert (len(bpy.data.scenes), len(bpy.data.objects), len(bpy.data.armatures), len(bpy.data.actions)) == before
+    with ArmatureEvaluator(obj, [b.name for b in obj.pose.bones]):
+        assert len(bpy.data.scenes) == before[0] + 1
+    assert len(bpy.data.scenes) == before[0]

@@ -55,12 +55,19 @@ class ArmatureEvaluator:
     def __init__(self, obj: bpy.types.Object, bone_order, switches: dict[str, float] | None = None,
                  keyed: tuple[tuple[str, ...], str | None] | None = None):
         self.source_name = obj.name
+        self.action = None
         self.scene = bpy.data.scenes.new(f"kinect_retarget_probe_{obj.name}")
         self.copy = obj.copy()  # a pose of its own
         # the bones too: the Armature's own drivers (Rigify's B-Bone eases) read the object, and through
         # them the user's rig would be evaluated (and written back) with the copy
         self.copy.data = obj.data.copy()
-        self.action = None
+        try:
+            self._prepare(obj, bone_order, switches, keyed)
+        except BaseException:  # no temporary scene, object, armature or Action left behind
+            self.close()
+            raise
+
+    def _prepare(self, obj, bone_order, switches, keyed) -> None:
         if self.copy.animation_data is not None:
             self.copy.animation_data.action = None  # keys would overwrite the poses set here; drivers stay
             if keyed is not None:
