@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .quat import mul, normalize
+from .quat import from_axis_angle, mul, normalize
 
 UNKNOWN, NOT_TRACKED, OPEN, CLOSED, LASSO = 0, 1, 2, 3, 4  # Kinect v2 HandState
 FINGERS = ("thumb", "index", "middle", "ring", "pinky")
@@ -59,12 +59,6 @@ def finger_curls(states: np.ndarray, times: np.ndarray, smooth_s: float = SMOOTH
     return out
 
 
-def axis_angle_quat(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """(..., 3) unit axes and (...,) angles -> (..., 4) quaternions."""
-    half = np.asarray(angle)[..., None] / 2
-    return np.concatenate([np.cos(half), np.sin(half) * axis], axis=-1)
-
-
 def signed_angle(a: np.ndarray, b: np.ndarray, axis: np.ndarray) -> np.ndarray:
     """Angle (radians) turning a to b about `axis`, all (..., 3); a and b projected off the axis."""
     a = a - np.sum(a * axis, -1, keepdims=True) * axis
@@ -85,7 +79,7 @@ def hand_roll(desired: np.ndarray, thumb_local: np.ndarray, thumb_dir: np.ndarra
 def twist_quats(quats: np.ndarray, angle: np.ndarray) -> np.ndarray:
     """Pose quaternions (F, 4) turned by (F,) radians about the bone's own Y axis (applied last, in bone
     space, so the bone's direction is unchanged)."""
-    return mul(quats, axis_angle_quat(np.array([0.0, 1.0, 0.0]), angle))
+    return mul(quats, from_axis_angle(np.array([0.0, 1.0, 0.0]), angle))
 
 
 def fingers_bend(desired: np.ndarray, curl_axis_local: np.ndarray, tip_dir: np.ndarray) -> np.ndarray:
@@ -100,4 +94,4 @@ def fingers_bend(desired: np.ndarray, curl_axis_local: np.ndarray, tip_dir: np.n
 def finger_quats(axis_local: np.ndarray, angle: np.ndarray) -> np.ndarray:
     """(F, 4) pose rotations of one finger bone: `angle` (F,) radians about its curl axis (3,) in its own
     frame (positive curls toward the palm)."""
-    return axis_angle_quat(np.broadcast_to(normalize(axis_local), (len(angle), 3)), angle)
+    return from_axis_angle(np.broadcast_to(normalize(axis_local), (len(angle), 3)), angle)

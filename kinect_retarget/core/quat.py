@@ -65,6 +65,11 @@ def from_axes(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
     return q
 
 
+def from_axis_angle(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """(..., 3) unit axes and (...,) angles (radians) -> (..., 4) quaternions."""
+    half = np.asarray(angle)[..., None] / 2
+    return np.concatenate([np.cos(half), np.sin(half) * axis], axis=-1)
+
 def from_matrix(m: np.ndarray) -> np.ndarray:
     """(..., 3, 3) rotation matrices -> (..., 4) unit quaternions with w >= 0 (see from_axes)."""
     m = np.asarray(m, dtype=np.float64)

@@ -15,7 +15,7 @@ from bpy_extras import anim_utils
 
 from ...core.parent_fit import learn, relative_to_parent
 from ...core.parent_model import ParentModel
-from ...core.quat import angle_between, from_matrix, make_continuous, normalize
+from ...core.quat import angle_between, from_axis_angle, from_matrix, make_continuous, normalize
 from ...core.target_rig import TargetRig
 from .pose_apply import set_rotations
 
@@ -191,8 +191,7 @@ def constraint_targets(obj: bpy.types.Object, rig: TargetRig) -> dict[int, list[
 
 def random_rotations(rng: np.random.Generator, n: int, max_angle: float) -> np.ndarray:
     axis = normalize(rng.normal(size=(n, 3)))
-    half = rng.uniform(0, max_angle, n)[:, None] / 2
-    return np.concatenate([np.cos(half), np.sin(half) * axis], axis=1)
+    return from_axis_angle(axis, rng.uniform(0, max_angle, n))
 
 
 def probe_parents(evaluator: ArmatureEvaluator, obj: bpy.types.Object, rig: TargetRig, bone_names,
