@@ -1,11 +1,10 @@
 """Find the Kinect v1 joints in any humanoid skeleton from its structure, not its names.
 
-One mapper for every source of skeletons: a BVH hierarchy (takes/bvh_figure.py) and, through the same call,
-a Blender armature (issue 16). Pure numpy.
+One mapper for every skeleton: a BVH hierarchy (takes/bvh_figure.py) and an armature (armature_mapping.py).
 
 API
 ---
-``map_structure(names, parents, rest, frames=None, end_site=None) -> StructureMapping``
+``map_structure(names, parents, rest, frames=None, end_site=None, armature=False) -> StructureMapping``
 
 * ``names``: (N,) node names; used only as a tiebreak (left/right when the figure cannot tell, twist bones in
   a single-frame skeleton) and for Kinect-named skeletons, which map one to one.

@@ -45,3 +45,12 @@ def test_renamed_metarig_maps_by_structure_prints_and_bakes(bpy_empty, tmp_path,
     res = bake_take(obj, take, preset="auto", settings=RetargetSettings(filter="none", fps=take.rate))
     assert res.preset == "structure"
     assert {back[b] for b in res.motion.bone_names} >= {"upper_arm.L", "forearm.R", "thigh.L", "spine"}
+
+
+def test_sidebar_fills_the_table_by_structure(registered):
+    bpy = registered
+    obj, back = _renamed_metarig(bpy)
+    s = bpy.context.scene.kinect_retarget
+    s.target = obj
+    assert bpy.ops.kinect_retarget.mapping_from_preset() == {"FINISHED"}
+    assert {back[row.bone]: row.joint for row in s.mapping if row.enabled} == RIGIFY_METARIG

@@ -43,7 +43,8 @@ class KINECT_RETARGET_UL_mapping(bpy.types.UIList):
 
 
 class KINECT_RETARGET_OT_mapping_from_preset(bpy.types.Operator):
-    """Fill the bone-mapping table from the preset (auto: detected from the armature's bone names)"""
+    """Fill the bone-mapping table from the preset (auto: detected from the armature's bone names, or found from
+    its hierarchy and rest pose when no preset names them); every row can then be edited"""
     bl_idname = "kinect_retarget.mapping_from_preset"
     bl_label = "Fill Mapping from Preset"
     bl_options = {"REGISTER", "UNDO"}
@@ -66,7 +67,9 @@ class KINECT_RETARGET_OT_mapping_from_preset(bpy.types.Operator):
             return {"CANCELLED"}
         present = {b.name for b in obj.data.bones}
         fill_table(s, {b: j for b, j in mapping.items() if b in present})
-        self.report({"INFO"}, f"Mapping filled from preset {used!r}: {len(s.mapping)} bones")
+        how = ("found from the armature's structure (python -m kinect_retarget info --rig says how)"
+               if used == "structure" else f"from preset {used!r}")
+        self.report({"INFO"}, f"Mapping {how}: {len(s.mapping)} bones")
         return {"FINISHED"}
 
 
