@@ -36,6 +36,9 @@ class TakePlayback(FrameSource):
         if len({t.frame_count for t in self.takes.values()}) > 1:
             raise SourceError(f"take file {self.path}: its bodies have different frame counts")
         super().__init__(self.take.skeleton, self.take.rate)
+        read = [w for t in self.takes.values() for w in t.metadata.get("warnings", ())]
+        if read:  # what the reader dropped (bad samples, a cut-off line): shown as bake shows it
+            self.warning = "; ".join(dict.fromkeys(read))
 
     def describe(self) -> str:
         return f"take {self.path}" if self.path else "take playback"

@@ -52,6 +52,20 @@ def test_playback_missing_file_is_a_clear_error(tmp_path):
         TakePlayback(tmp_path / "nope.krtake")
 
 
+
+def test_playback_shows_the_samples_the_reader_dropped(tmp_path):
+    """A take with a few NaN samples plays its good ones, the reader's warning shown as the source's."""
+    csv = os.path.join(os.path.dirname(__file__), "..", "data", "kinect_v2", "Ges01_wavehand.csv")
+    with open(csv) as fh:
+        lines = [fh.readline().rstrip().rstrip(",") for _ in range(20)]
+    cells = lines[5].split(",")
+    lines[5] = ",".join(c if i == 0 or i % 4 == 0 else "nan" for i, c in enumerate(cells))  # states kept
+    path = tmp_path / "some_nan.csv"
+    path.write_text("\n".join(lines) + "\n")
+    src = TakePlayback(path)
+    assert src.take.frame_count == 20
+    assert src.warning is not None and "some_nan.csv:6" in src.warning and "NaN" in src.warning
+
 def test_playback_file_vanishing_stops_with_error(wave_take_file):
     src = TakePlayback(wave_take_file, speed=1.0)
     q = FrameQueue()
