@@ -100,7 +100,7 @@ def detect_preset(bone_names) -> str:
     best = max(scores, key=lambda p: scores[p])
     if scores[best] < 6:
         raise ValueError("no bone-mapping preset fits this armature (found at most "
-                         f"{scores[best]} known bone names); pick a preset or give a mapping file")
+                         f"{int(scores[best])} known bone names); pick a preset or give a mapping file")
     return best
 
 
