@@ -15,7 +15,7 @@ from ..core.key_reduction import Reduction, reduce_keys
 from ..core.foot_lock import FeetReport, FootLock, key_rate
 from ..core.kinect_rig_layout import median_segment_lengths
 from ..core.pipeline import BakedMotion, RetargetPipeline, RetargetSettings
-from ..core.presets import build_mapping, mapping_problems
+from ..core.presets import PRESET_INFO, build_mapping, mapping_problems
 from ..core.resample import resample_motion
 from ..core.root_motion import apply_root_motion
 from ..core.rotation_modes import channel_values
@@ -145,7 +145,8 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
                               settings.mirror)
     root_note = ""
     if options.root_motion:  # after the constrained solve: the keys are final, only the hips change
-        root_note = "; " + apply_root_motion(motion, pipeline.rig, options.root_motion_facing, options.root_bone)
+        named = options.root_bone or PRESET_INFO.get(used, {}).get("root_motion_bone")  # Mannequin's 'root'
+        root_note = "; " + apply_root_motion(motion, pipeline.rig, options.root_motion_facing, named)
     take_name = whole.metadata.get("name", "take")
     name = action_name or f"{obj.name}_{take_name}"
     reduction = _reduce(obj, motion, options)

@@ -31,7 +31,8 @@ def find_root_bone(rig: TargetRig, hips: int, named: str | None = None) -> int:
         root = rig.index(named)
         if root not in rig.ancestors(hips):
             raise RootMotionError(f"root motion: {named!r} is not an ancestor of the hips bone "
-                                  f"{rig.bone_names[hips]!r}")
+                                  f"{rig.bone_names[hips]!r} (a rig whose hips follow the root by constraints, "
+                                  "as Rigify's, cannot carry root motion this way)")
         return root
     above = rig.ancestors(hips)
     if not above:

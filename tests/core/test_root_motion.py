@@ -63,3 +63,5 @@ def test_rig_without_a_root_bone_is_a_clear_error(baked):
         apply_root_motion(m, rig)
     with pytest.raises(RootMotionError, match="no bone named 'floor'"):
         apply_root_motion(m, rig, named="floor")
+    with pytest.raises(RootMotionError, match="not an ancestor of the hips"):
+        apply_root_motion(m, rig, named="hand.l")
