@@ -8,6 +8,7 @@ import os
 import sys
 
 from ..core.kinect_rig_layout import typical_segment_lengths
+from .performer_args import add_performer_args, performers
 
 
 def add_parsers(sub) -> None:
@@ -18,8 +19,7 @@ def add_parsers(sub) -> None:
     p = sub.add_parser("live", help="drive a rig live from a source without a window; prints JSON statistics")
     p.add_argument("--source", required=True, help="take:FILE, osc:PORT or usb")
     p.add_argument("--seconds", type=float, required=True, help="how long to run")
-    p.add_argument("--rig", help=".blend holding the target armature (default: a generated Kinect rig)")
-    p.add_argument("--armature", help="armature object name in --rig (default: the only armature)")
+    add_performer_args(p, ".blend holding the target armature(s) (default: a generated Kinect rig per body)")
     p.add_argument("--preset", default="auto", choices=PRESET_NAMES, help="bone-mapping preset (default: auto)")
     p.add_argument("--mapping", help="JSON bone-mapping overrides")
     p.add_argument("--filter", default="default", choices=FILTERS, help="jitter filter (default: default)")
@@ -51,12 +51,18 @@ def stdout_to_stderr():
 
 def run_live(args) -> int:
     from ..sources import SourceError, open_source
+    from ..takes import body_count
 
     if not args.seconds > 0:
         raise ValueError("--seconds must be positive")
     try:
         source = open_source(args.source, speed=args.speed, loop=args.loop, host=args.host,
                              simulate=args.simulate)
+        take = getattr(source, "take", None)
+        pairs = performers(args, None if take is None else body_count(take), args.source)
+        if take is not None and [b for b, _ in pairs] != [0]:  # play every body the rigs follow
+            source = open_source(args.source, speed=args.speed, loop=args.loop,
+                                 bodies=tuple(b for b, _ in pairs))
     except SourceError as exc:  # bad input fails before Blender starts
         raise ValueError(str(exc)) from None
     overrides = None
@@ -74,7 +80,7 @@ def run_live(args) -> int:
             lengths = typical_segment_lengths(source.skeleton)
     with stdout_to_stderr():
         from ..blender.live.live_headless import run_headless
-        result = run_headless(source, args.seconds, rig_path=args.rig, armature=args.armature,
+        result = run_headless(source, args.seconds, rig_path=args.rig, performers=pairs,
                               preset=args.preset, filter_name=args.filter, root=args.root, mirror=args.mirror,
                               overrides=overrides, record=args.record, out=args.out, rig_lengths=lengths)
         result = {"source": args.source, **result}

@@ -13,6 +13,7 @@ from ..core.foot_lock import FEET_MODES
 from ..core.presets import PRESET_NAMES
 from ..core.retarget import ROOT_MODES
 from ..takes import body_count, load_take
+from .performer_args import add_performer_args, performers
 
 
 def add_parsers(sub) -> None:
@@ -29,13 +30,7 @@ def add_parsers(sub) -> None:
     p.add_argument("take")
     p.add_argument("--out", required=True,
                    help="output .blend, or .fbx / .glb / .gltf / .bvh exported with game-engine settings")
-    p.add_argument("--rig", help=".blend holding the target armature(s) (default: a generated Kinect rig per body)")
-    p.add_argument("--armature", action="append",
-                   help="armature object name in --rig (default: the only armature); repeat it with --body to "
-                        "bake each performer onto its own rig, paired in order")
-    p.add_argument("--body", action="append", type=body_arg,
-                   help="which performer of a take with several (NTU, Kinectron; from 0; default 0); repeat "
-                        "it (one per --armature) or give 'all' to bake every body onto its own rig")
+    add_performer_args(p, ".blend holding the target armature(s) (default: a generated Kinect rig per body)")
     p.add_argument("--preset", choices=PRESET_NAMES, default="auto")
     p.add_argument("--mapping", help="JSON {bone: joint} overriding the preset per bone")
     p.add_argument("--filter", choices=FILTERS, default="default")
@@ -83,39 +78,6 @@ def add_bake_option_args(p) -> None:
     g.add_argument("--set-scene-fps", action="store_true", help="set the rig file's scene to the key rate")
     g.add_argument("--extend-range", action="store_true",
                    help="grow the rig file's scene range to hold the keys (never shortens it)")
-
-
-def body_arg(text: str) -> int | str:
-    if text == "all":
-        return text
-    if not text.isdigit():
-        raise ValueError(f"--body takes a body number from 0 or 'all', not {text!r}")
-    return int(text)
-
-
-def performers(args, bodies_in_take: int) -> list[tuple[int, str | None]]:
-    """(body, armature name or None) for each rig the bake drives, from --body and --armature."""
-    bodies = args.body or [0]
-    names = args.armature or []
-    if "all" in bodies:
-        if len(bodies) > 1:
-            raise ValueError("--body all bakes every body: give it alone")
-        bodies = list(range(bodies_in_take))
-    if len(set(bodies)) != len(bodies):
-        raise ValueError(f"--body repeats a body ({', '.join(map(str, bodies))})")
-    for b in bodies:
-        if b >= bodies_in_take:
-            raise ValueError(f"{args.take}: no body {b} (the take holds {bodies_in_take}, numbered from 0)")
-    if not args.rig and names:  # (one body too: the generated rig would ignore the name)
-        raise ValueError("--armature names armatures in --rig; without --rig each body gets a generated rig")
-    if len(bodies) == 1:
-        if len(names) > 1:
-            raise ValueError("several --armature need as many --body (one rig per performer)")
-        return [(bodies[0], names[0] if names else None)]
-    if args.rig and len(names) != len(bodies):
-        raise ValueError(f"{len(bodies)} bodies need {len(bodies)} --armature names in --rig, paired in order "
-                         f"(got {len(names)})")
-    return list(zip(bodies, names or [None] * len(bodies)))
 
 
 def bake_options_from_args(args) -> BakeOptions:
@@ -196,7 +158,7 @@ def run_bake(args) -> int:
     from ..core.presets import load_mapping_file
 
     take = load_take(args.take, scale=args.scale)  # bad input fails here, before Blender starts
-    pairs = performers(args, body_count(take))
+    pairs = performers(args, body_count(take), args.take)
     takes = [take if body == 0 else load_take(args.take, body=body) for body, _ in pairs]
     name = os.path.splitext(os.path.basename(args.take))[0]
     for (body, _), t in zip(pairs, takes):

@@ -102,3 +102,20 @@ def test_bad_performer_arguments_are_named(tmp_path, two_person_take, shared_dat
     rc, _, err = _cli("bake", shared_data / "kinect_v2" / "Ges01_wavehand.csv", "--out", tmp_path / "x.blend",
                       "--armature", "Nope")  # one body, no --rig: the name would be ignored
     assert rc == 2 and "without --rig" in err
+
+
+def test_live_command_drives_a_rig_per_body(tmp_path, two_person_take):
+    rc, stdout, stderr = _cli("live", "--source", f"take:{two_person_take}", "--seconds", 60, "--speed", 4,
+                              "--body", "all", "--filter", "none", "--record", tmp_path / "duo.krtake",
+                              "--out", tmp_path / "duo.blend")
+    assert rc == 0, stderr
+    result = json.loads(stdout.strip().splitlines()[-1])
+    assert [(p["armature"], p["body"]) for p in result["performers"]] == [("KinectRig_body0", 0),
+                                                                          ("KinectRig_body1", 1)]
+    assert all(p["action"] and p["applied"] > 0 and p["error"] is None for p in result["performers"])
+    from kinect_retarget.takes import load_take
+    for rec, body in (("duo.krtake", 0), ("duo_body1.krtake", 1)):  # each body recorded on its own
+        got, want = load_take(tmp_path / rec), load_take(two_person_take, body=body)
+        np.testing.assert_allclose(got.positions[-1], want.positions[-1], atol=2e-5)
+    rc, _, err = _cli("live", "--source", "osc:0", "--seconds", 1, "--body", "all")
+    assert rc == 2 and "needs a take" in err

@@ -10,7 +10,7 @@ import bpy
 from ...core.pipeline import RetargetSettings
 from ...sources import SourceError
 from ..bake_take import set_scene_rate
-from ..headless import blender_message, open_target, save_blend
+from ..headless import blender_message, find_armature, open_target, save_blend
 from ..io.kinect_rig import build_kinect_rig
 from .live_controller import LiveSettings
 from .live_runtime import pump_live, start_live, stop_live
@@ -18,17 +18,27 @@ from .live_runtime import pump_live, start_live, stop_live
 
 def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset="auto",
                  filter_name="default", root="xyz", mirror=False, overrides=None, record=None, out=None,
-                 rig_lengths=None) -> dict:
+                 rig_lengths=None, performers=None) -> dict:
     """Run live for `seconds` (or until the source ends) on the rig in `rig_path` (or the generated one with
-    `rig_lengths`), record to `record` and bake it, save `out`. Returns the statistics."""
+    `rig_lengths`), record to `record` and bake it, save `out`. Returns the statistics. `performers`
+    [(body, armature name or None)]: one rig per body of the source (the named armatures of `rig_path`, or a
+    generated rig each), the first leading; `armature` is the one rig's name without it."""
     from ... import register, unregister
 
-    def generate(scene):
-        obj = build_kinect_rig(scene, source.skeleton, rig_lengths, "KinectRig")
-        set_scene_rate(scene, source.rate)  # a new scene runs at the source's rate, as `bake` sets it
-        return obj
+    performers = list(performers or [(0, armature)])
+    several = len(performers) > 1
 
-    obj, preset = open_target(rig_path, armature, preset, generate)
+    def generate(scene):
+        rigs = [build_kinect_rig(scene, source.skeleton, rig_lengths, f"KinectRig_body{b}" if several else "KinectRig")
+                for b, _ in performers]
+        set_scene_rate(scene, source.rate)  # a new scene runs at the source's rate, as `bake` sets it
+        return rigs[0]
+
+    obj, preset = open_target(rig_path, performers[0][1], preset, generate)
+    if rig_path:
+        others = [(find_armature(name), b) for b, name in performers[1:]]
+    else:
+        others = [(bpy.data.objects[f"KinectRig_body{b}"], b) for b, _ in performers[1:]]
     register()   # once the rig is there: neither opening nor building it needs the add-on
     try:
         bpy.context.view_layer.objects.active = obj
@@ -37,7 +47,8 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
                                                                           mirror=mirror),
                                 bake_on_stop=bool(record))
         try:
-            c = start_live(bpy.context, source, settings, overrides or None, armature=obj, use_timer=False)
+            c = start_live(bpy.context, source, settings, overrides or None, armature=obj, use_timer=False,
+                           body=performers[0][0], followers=others)
         except SourceError as exc:
             raise ValueError(str(exc)) from None
         if record:
@@ -56,6 +67,9 @@ def run_headless(source, seconds: float, *, rig_path=None, armature=None, preset
         result = {"seconds": round(elapsed, 3), "armature": obj.name, **c.session.statistics(),
                   "error": c.session.error, "record": os.path.abspath(record) if record else None,
                   "action": c.baked_action, "warning": source.warning}
+        if c.followers:
+            result["performers"] = [{"armature": f.obj_name, "body": f.body, "action": f.baked_action,
+                                     "error": f.session.error, **f.session.statistics()} for f in (c, *c.followers)]
         if hasattr(source, "bad_packets"):
             result["bad_packets"] = source.bad_packets
         if out:
