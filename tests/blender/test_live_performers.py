@@ -111,6 +111,7 @@ def test_a_two_person_take_from_the_sidebar_drives_each_rig_with_its_body(two_ri
     assert s.performers[0].body == 1
     c = live.start_live(bpy.context, use_timer=False)
     rec = c.start_recording(bpy.context, play=False)
+    assert _wait(lambda: (live.status().get("progress") or (0, 0))[0] > 1)  # the take's frame, behind the fanout
     _wait(lambda: not live.pump_live() and live.controller() is None)
     assert live.controller() is None and live.status()["error"] is None
     a, b = krtake.read(rec), krtake.read(rec.replace(".krtake", "_body1.krtake"))

@@ -15,7 +15,7 @@ from bpy.app.handlers import persistent
 
 from ...core.pipeline import RetargetSettings
 from ...sources import SourceError, TakePlayback, open_source
-from ...sources.body_fanout import BodyFanout
+from ...sources.body_fanout import BodyFanout, BodySource
 from ..ui.mapping_table import table_overrides
 from ..ui.performers import other_performers
 from ..ui.preferences import get_preferences
@@ -179,9 +179,14 @@ def status() -> dict:
             "error": src.error, "warning": src.warning, "stats": c.session.statistics(),
             "tracked": c.session.last_tracked_joints, "joints": len(src.skeleton),
             "calibrating": c.session.calibrating, "device": getattr(src, "device_status", None),
-            "progress": (src.position + 1, src.take.frame_count) if isinstance(src, TakePlayback) else None,
+            "progress": (src.position + 1, src.take.frame_count) if isinstance(_shared(src), TakePlayback) else None,
             "recording": c.recording["path"] if c.recording else None,
             "performers": [(c.obj_name, c.body)] + [(f.obj_name, f.body) for f in c.followers if not f.finished]}
+
+
+def _shared(src):
+    """The source itself, also behind one body's view of it."""
+    return src.fanout.source if isinstance(src, BodySource) else src
 
 
 def set_error_status(message: str) -> None:
