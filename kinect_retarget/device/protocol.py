@@ -164,7 +164,7 @@ def parse_packet_header(packet: bytes) -> PacketHeader | None:
 
 def build_packet_header(flag: int, seq: int, length: int, timestamp: int) -> bytes:
     return (_PACKET.pack(MAGIC_REPLY, 0, flag, 0, seq & 0xFF) + (length & 0xFFFF).to_bytes(2, "big")
-            + (timestamp & 0xFFFFFFFF).to_bytes(4, "little"))
+            + wrap_ticks(timestamp).to_bytes(4, "little"))
 
 
 def depth_packet_flag(index_in_frame: int) -> int:
@@ -175,7 +175,18 @@ def depth_packet_flag(index_in_frame: int) -> int:
     return FLAG_DEPTH_MOF
 
 
+# --- the device clock: a 32-bit counter of 60 MHz ticks. These three are the only places it wraps. ---------
+def wrap_ticks(ticks):
+    """A tick count (int or array) as the device's 32-bit clock shows it: modulo 2**32, never negative."""
+    return ticks % TIMESTAMP_WRAP
+
+
+def advance_ticks(stamp, ticks):
+    """The clock reading `ticks` after `stamp` (ints or arrays), wrapping past 2**32."""
+    return wrap_ticks(stamp + ticks)
+
+
 def ticks_between(earlier, later):
     """Device clock ticks from `earlier` to `later` (ints or arrays): the 32-bit counter wraps, so a later
-    stamp may be smaller. The one place the wrap is undone (capture files, live depth, the CLI)."""
-    return (later - earlier) % TIMESTAMP_WRAP
+    stamp may be smaller. The one place the wrap is undone (capture files, live depth, reassembly, the CLI)."""
+    return wrap_ticks(later - earlier)

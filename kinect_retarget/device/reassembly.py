@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 from .protocol import (DEPTH_FRAME_BYTES, DEPTH_LAST_PAYLOAD, DEPTH_PACKETS_PER_FRAME, DEPTH_PAYLOAD,
                        FLAG_DEPTH_EOF, FLAG_DEPTH_MOF, FLAG_DEPTH_SOF, PACKET_HEADER_SIZE,
-                       TICKS_PER_FRAME)
+                       TICKS_PER_FRAME, advance_ticks, ticks_between)
 
 MAX_GAP = 5
 MAX_LOST_PER_FRAME = 5
@@ -107,7 +107,7 @@ class FrameAssembler:
             return None
         self.stats.frames += 1
         if self._last_delivered is not None:
-            gap = round(((self._timestamp - self._last_delivered) & 0xFFFFFFFF) / TICKS_PER_FRAME) - 1
+            gap = round(ticks_between(self._last_delivered, self._timestamp) / TICKS_PER_FRAME) - 1
             self.stats.frames_missed += gap if 0 < gap < MAX_COUNTED_GAP else 0
         self._last_delivered = self._timestamp
         return AssembledFrame(buf, self._timestamp, lost, holes)
@@ -123,7 +123,7 @@ class FrameAssembler:
         if not 0 < pos <= self.max_gap or flag != (FLAG_DEPTH_EOF if pos == last else FLAG_DEPTH_MOF):
             return False
         self._start_frame(seq)
-        self._timestamp = (self._anchor[1] + (since // DEPTH_PACKETS_PER_FRAME) * TICKS_PER_FRAME) & 0xFFFFFFFF
+        self._timestamp = advance_ticks(self._anchor[1], (since // DEPTH_PACKETS_PER_FRAME) * TICKS_PER_FRAME)
         self._pkt = self._lost = pos
         self._hole(0, pos)
         return True
@@ -132,7 +132,7 @@ class FrameAssembler:
         """Skip `count` packets at the start of a frame: its start-of-frame (and timestamp) was lost, so the
         timestamp follows the previous frame's, which is exact because the previous frame just ended."""
         if count:
-            self._timestamp = (self._timestamp + TICKS_PER_FRAME) & 0xFFFFFFFF
+            self._timestamp = advance_ticks(self._timestamp, TICKS_PER_FRAME)
         self._pkt = count
         self._lost = count
         self._seq = seq

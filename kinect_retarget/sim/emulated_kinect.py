@@ -27,7 +27,7 @@ from .emulated_audio import AudioBootloader
 from .emulated_libusb import EmulatedLibusb
 from .emulated_stream import DepthPacketizer, DepthStreamState, FaultyWire, Faults, VirtualClock
 from .emulated_usb import EmulatedHandle, UsbFunction, build_functions, calibration_reply
-from ..device.protocol import TICKS_PER_FRAME
+from ..device.protocol import TICKS_PER_FRAME, ticks_between
 from ..device.usb_backend import LIBUSB_ERROR_NO_DEVICE
 
 LIBUSB_ERROR_PIPE = -9
@@ -87,7 +87,7 @@ class EmulatedKinect(usb.backend.IBackend):
     def expected_frame(self, timestamp: int) -> tuple[int, int]:
         """(stream number, frame number in that stream) that a delivered frame's timestamp belongs to."""
         for n, packetizer in enumerate(self.streams):
-            offset = (timestamp - packetizer.first_timestamp) & 0xFFFFFFFF
+            offset = ticks_between(packetizer.first_timestamp, timestamp)
             if offset % TICKS_PER_FRAME == 0:
                 return n, offset // TICKS_PER_FRAME
         raise KeyError(f"timestamp {timestamp} belongs to no emulated stream")

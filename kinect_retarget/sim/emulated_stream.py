@@ -13,7 +13,7 @@ import numpy as np
 
 from ..device.depth_unpack import pack_11bit
 from ..device.protocol import (DEPTH_LAST_PAYLOAD, DEPTH_PACKETS_PER_FRAME, DEPTH_PAYLOAD, PACKET_HEADER_SIZE,
-                       TICKS_PER_FRAME, build_packet_header, depth_packet_flag)
+                               TICKS_PER_FRAME, advance_ticks, build_packet_header, depth_packet_flag)
 
 MICROFRAME_S = 125e-6
 FRAME_S = 1.0 / 30.0
@@ -52,7 +52,7 @@ class DepthPacketizer:
         self.first_timestamp = first_timestamp
 
     def timestamp(self, frame: int) -> int:
-        return (self.first_timestamp + frame * TICKS_PER_FRAME) & 0xFFFFFFFF
+        return advance_ticks(self.first_timestamp, frame * TICKS_PER_FRAME)
 
     @staticmethod
     def packet_length(index: int) -> int:

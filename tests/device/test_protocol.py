@@ -1,5 +1,6 @@
 import struct
 
+import numpy as np
 import pytest
 
 from kinect_retarget.device import protocol as P
@@ -76,3 +77,25 @@ def test_models():
     assert P.camera_model(0x02AE, 0x110) == "Xbox 360 Kinect (1473)"
     assert P.camera_model(0x02BF, 0x100) == "Kinect for Windows"
     assert P.is_model_1414(0x02AE, 267) and not P.is_model_1414(0x02BF, 267)
+
+
+def test_device_clock_wraps_at_2_to_the_32():
+    top = P.TIMESTAMP_WRAP - 1                          # the counter's last reading before it wraps to 0
+    assert P.wrap_ticks(top) == top and P.wrap_ticks(top + 1) == 0 and P.wrap_ticks(-1) == top
+    assert P.advance_ticks(top, 1) == 0
+    assert P.advance_ticks(top - P.TICKS_PER_FRAME + 1, P.TICKS_PER_FRAME) == 0
+    assert P.advance_ticks(top - 1_000_000, P.TICKS_PER_FRAME) == P.TICKS_PER_FRAME - 1_000_001
+    assert P.ticks_between(top, 0) == 1 and P.ticks_between(0, top) == top
+    assert P.ticks_between(top - 1_000_000, P.advance_ticks(top - 1_000_000, P.TICKS_PER_FRAME)) == P.TICKS_PER_FRAME
+    # the same values the inline `& 0xFFFFFFFF` gave, for ints on both sides of the boundary and for arrays
+    for t in (-P.TIMESTAMP_WRAP - 5, -1, 0, 1, top, top + 1, top + P.TICKS_PER_FRAME, 3 * P.TIMESTAMP_WRAP + 7):
+        assert P.wrap_ticks(t) == t & 0xFFFFFFFF
+    earlier = np.array([top - 5, top, 0, 17], dtype=np.int64)
+    later = np.array([2, 0, top, 17], dtype=np.int64)
+    assert P.ticks_between(earlier, later).tolist() == [8, 1, top, 0]
+    assert P.advance_ticks(earlier, P.TICKS_PER_FRAME).tolist() == ((earlier + P.TICKS_PER_FRAME) & 0xFFFFFFFF).tolist()
+
+
+def test_packet_header_carries_the_wrapped_stamp():
+    header = P.build_packet_header(P.FLAG_DEPTH_SOF, 3, 1760, P.TIMESTAMP_WRAP + 42)
+    assert P.parse_packet_header(header + bytes(4)).timestamp == 42
