@@ -111,3 +111,19 @@ def test_packages_import_only_the_layers_below_them():
                 if other != pkg and (PACKAGE / other).is_dir() and other not in allowed:
                     offenders.append(f"{path.relative_to(PACKAGE)} imports {target}")
     assert not offenders, "imports against the layer order: " + "; ".join(sorted(set(offenders)))
+
+
+def test_no_imports_from_name_strings():
+    """The checks above read import statements: a module imported from a name string (importlib, __import__)
+    would slip past them, and a missing one can be skipped silently. Imports are static everywhere."""
+    offenders = []
+    for path in PACKAGE.rglob("*.py"):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in ast.walk(tree):
+            dynamic = (isinstance(node, ast.Import) and any(a.name.split(".")[0] == "importlib" for a in node.names)
+                       or isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] == "importlib"
+                       or isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                       and node.func.id == "__import__")
+            if dynamic:
+                offenders.append(f"{path.relative_to(PACKAGE)}:{node.lineno}")
+    assert not offenders, "imports from name strings: " + ", ".join(offenders)

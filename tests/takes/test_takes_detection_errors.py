@@ -220,3 +220,11 @@ def test_every_reader_take_saves_as_krtake(shared_data, tmp_path, rel):
     source_meta = {k: v for k, v in take.metadata.items() if k not in ("time_unit", "bodies")}
     assert back.metadata.pop("time_unit") == "s"
     assert back.metadata == json.loads(json.dumps(source_meta))
+
+
+def test_readers_are_tried_in_a_fixed_order_and_multi_body_names_readers():
+    from kinect_retarget import takes
+    assert READERS == ("krtake", "kinectron_json", "bvh", "kinect_v2_csv", "uiprmd", "msrc12", "utkinect",
+                       "ntu_skeleton")
+    assert set(takes.MULTI_BODY) <= set(READERS)
+    assert all(callable(getattr(takes, name).looks_like) and callable(getattr(takes, name).read) for name in READERS)
