@@ -17,7 +17,7 @@ from ..core.kinect_rig_layout import median_segment_lengths
 from ..core.pipeline import BakedMotion, RetargetPipeline, RetargetSettings
 from ..core.presets import PRESET_INFO, build_mapping, mapping_problems
 from ..core.resample import resample_motion
-from ..core.root_motion import apply_root_motion
+from ..core.root_motion import apply_root_motion, root_follows_by_constraints
 from ..core.rotation_modes import channel_values
 from ..core.skeletons import Skeleton
 from ..core.take import Take
@@ -26,6 +26,7 @@ from .io.armature_probe import constrained_summary, solve_baked
 from .io.finger_rig import apply_hands, hands_on_rig
 from .io.kinect_rig import build_kinect_rig
 from .io.rig_reader import fk_switch_bones, has_constrained_ancestry, target_rig_from_object
+from .io.root_follow import root_follow_problem
 
 Report = Callable[[set, str], None]
 
@@ -134,6 +135,13 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
     extra = []
     if used == "rigify":
         extra = [(f'pose.bones["{escape_identifier(b)}"]["IK_FK"]', b, np.ones(1)) for b in fk_switch_bones(obj)]
+    root_named = options.root_bone or PRESET_INFO.get(used, {}).get("root_motion_bone")  # Mannequin's, Rigify's root
+    root_note = ""
+    if options.root_motion and root_follows_by_constraints(pipeline.rig, motion, root_named):
+        # Rigify: the hips follow the root by constraints; once verified, the root joins the constrained solve,
+        # which turns the hips (and whatever else follows the root) back
+        root_note = "; " + apply_root_motion(motion, pipeline.rig, options.root_motion_facing, root_named,
+                                             lambda r, h: root_follow_problem(obj, pipeline.rig, r, h))
     if has_constrained_ancestry(obj, motion.bone_names):
         n = len(motion.frames)
         model = solve_baked(obj, pipeline.rig, motion, {name: 1.0 for _, name, _ in extra},
@@ -143,10 +151,8 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
     if options.hands == "on" or (options.hands == "auto" and "HandTipLeft" in take.skeleton.joints):
         fingers = apply_hands(motion, hands_on_rig(obj, pipeline.retargeter.mapped), take, take.skeleton.joints,
                               settings.mirror)
-    root_note = ""
-    if options.root_motion:  # after the constrained solve: the keys are final, only the hips change
-        named = options.root_bone or PRESET_INFO.get(used, {}).get("root_motion_bone")  # Mannequin's 'root'
-        root_note = "; " + apply_root_motion(motion, pipeline.rig, options.root_motion_facing, named)
+    if options.root_motion and not root_note:  # after the constrained solve: the keys are final, only the hips change
+        root_note = "; " + apply_root_motion(motion, pipeline.rig, options.root_motion_facing, root_named)
     take_name = whole.metadata.get("name", "take")
     name = action_name or f"{obj.name}_{take_name}"
     reduction = _reduce(obj, motion, options)

@@ -23,16 +23,17 @@ class RootMotionError(ValueError):
     """The rig has no bone that can carry root motion (message says why)."""
 
 
-def find_root_bone(rig: TargetRig, hips: int, named: str | None = None) -> int:
-    """The bone to carry root motion: `named`, else the top ancestor of the hips bone."""
+def find_root_bone(rig: TargetRig, hips: int, named: str | None = None, constrained: bool = False) -> int:
+    """The bone to carry root motion: `named`, else the top ancestor of the hips bone. constrained: `named`
+    may be a bone the hips follow through constraints (the caller verifies that they do)."""
     if named:
         if not rig.has(named):
             raise RootMotionError(f"root motion: the armature has no bone named {named!r}")
         root = rig.index(named)
-        if root not in rig.ancestors(hips):
+        if root not in rig.ancestors(hips) and not constrained:
             raise RootMotionError(f"root motion: {named!r} is not an ancestor of the hips bone "
                                   f"{rig.bone_names[hips]!r} (a rig whose hips follow the root by constraints, "
-                                  "as Rigify's, cannot carry root motion this way)")
+                                  "as Rigify's, needs Blender's check: bake it in Blender)")
         return root
     above = rig.ancestors(hips)
     if not above:
@@ -103,23 +104,45 @@ def chain_is_free(rig: TargetRig, root: int, hips: int, posed_bones) -> str | No
     return None
 
 
-def apply_root_motion(motion, rig: TargetRig, facing: bool = False, named: str | None = None) -> str:
+def root_follows_by_constraints(rig: TargetRig, motion, named: str | None) -> bool:
+    """True when the root bone `named` is not an ancestor of the mapped hips (Rigify's root and torso)."""
+    if not named or motion.root_bone is None or not rig.has(named) or not rig.has(motion.root_bone):
+        return False
+    return rig.index(named) not in rig.ancestors(rig.index(motion.root_bone))
+
+
+def apply_root_motion(motion, rig: TargetRig, facing: bool = False, named: str | None = None,
+                      verify=None) -> str:
     """Move a BakedMotion's travel onto the root bone in place: the root bone joins motion.bone_names (its
     rotation keys) and motion.extras['locations'] (its location keys); the hips' keys compensate. Returns a
-    sentence for the bake report."""
+    sentence for the bake report.
+
+    verify: for a root bone the hips follow through constraints, a callable (root, hips) -> None when
+    Blender's evaluation shows the hips moving rigidly with the root, else why not. The root's desired
+    rotation then joins motion.extras['desired'], and the caller runs the constrained solve afterwards."""
     if motion.root_bone is None:
         raise RootMotionError("root motion: no bone is mapped to the hips (the root joint)")
     hips = rig.index(motion.root_bone)
-    root = find_root_bone(rig, hips, named)
+    root = find_root_bone(rig, hips, named, constrained=verify is not None)
     name = rig.bone_names[root]
     if name in motion.bone_names:
         raise RootMotionError(f"root motion: the root bone {name!r} is itself mapped to a joint")
-    why = chain_is_free(rig, root, hips, [rig.index(b) for b in motion.bone_names])
+    k = motion.bone_names.index(motion.root_bone)
+    hips_quats = motion.quats[:, k]
+    if root in rig.ancestors(hips):
+        why = chain_is_free(rig, root, hips, [rig.index(b) for b in motion.bone_names])
+    else:
+        assert verify is not None  # find_root_bone refused this root otherwise
+        why = verify(root, hips)
+        # with the root at rest the hips' frame is their rest (verified): their pose rotation is Hᵀ·desired
+        hips_quats = from_matrix(rig.rest[hips, :3, :3].T @ to_matrix(motion.extras["desired"][:, k]))
     if why:
         raise RootMotionError(f"root motion cannot use {name!r}: {why}")
-    k = motion.bone_names.index(motion.root_bone)
-    root_q, root_loc, hips_q, hips_loc = transfer_root_motion(rig, root, hips, motion.quats[:, k],
-                                                              motion.root_location, facing)
+    root_q, root_loc, hips_q, hips_loc = transfer_root_motion(rig, root, hips, hips_quats, motion.root_location,
+                                                              facing)
+    if root not in rig.ancestors(hips):  # the root's armature-space rotation, for the constrained solve after this
+        root_desired = from_matrix(rig.rest[root, :3, :3] @ to_matrix(root_q))
+        motion.extras["desired"] = np.concatenate([motion.extras["desired"], root_desired[:, None]], axis=1)
     motion.quats = np.concatenate([motion.quats, root_q[:, None]], axis=1)
     motion.quats[:, k] = hips_q
     motion.root_location = hips_loc

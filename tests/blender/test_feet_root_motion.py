@@ -7,6 +7,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from kinect_retarget.core.bake_options import BakeOptions
 from kinect_retarget.core.foot_contacts import intervals
@@ -88,3 +89,57 @@ def test_cli_bake_with_feet_and_root_motion(bpy_empty, tmp_path):
     bad = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(HOP), "--out", str(tmp_path / "x.blend"),
                           "--root-motion"], capture_output=True, text=True, timeout=300)
     assert bad.returncode != 0 and "root bone above the hips" in bad.stderr  # the generated rig has none
+
+
+def _pose_errors(a, b):
+    """Largest position (m) and rotation (degrees) difference between stacks of 4x4 matrices."""
+    ra, rb = a[..., :3, :3], b[..., :3, :3]
+    ra, rb = ra / np.linalg.norm(ra, axis=-2, keepdims=True), rb / np.linalg.norm(rb, axis=-2, keepdims=True)
+    rel = np.swapaxes(ra, -1, -2).astype(np.float64) @ rb
+    cos = (np.trace(rel, axis1=-2, axis2=-1) - 1) / 2      # arccos alone loses float32 matrices' small angles
+    sin = np.linalg.norm(rel - np.swapaxes(rel, -1, -2), axis=(-2, -1)) / (2 * np.sqrt(2))
+    return float(np.abs(a[..., :3, 3] - b[..., :3, 3]).max()), float(np.degrees(np.arctan2(sin, cos)).max())
+
+
+def test_root_motion_on_rigify_keys_root_and_keeps_the_world_pose(rigify_rig_path):
+    """Rigify's torso follows root through MCH-torso.parent's Armature constraint: root carries the travel
+    (and facing), torso is keyed so that every bone's world pose, as Blender evaluates the user's rig, is
+    the in-place bake's; an arm that follows the root part way is turned back too."""
+    import bpy
+
+    from kinect_retarget.blender.bake_take import bake_take
+    bpy.ops.wm.open_mainfile(filepath=str(rigify_rig_path))
+    obj = bpy.data.objects["rig"]
+    obj.pose.bones["upper_arm_parent.L"]["FK_limb_follow"] = 0.4
+    take = load_take(HOP).slice(slice(0, 240))
+    settings = RetargetSettings(fps=take.rate)
+    opts = dict(feet="off", hands="off")
+    plain = bake_take(obj, take, preset="rigify", settings=settings, options=BakeOptions(**opts))
+    frames = plain.motion.frames[::12]
+    # the keyed bones and the deforming ones (the IK controls and the torso's parent ride on root, as they should)
+    names = [pb.name for pb in obj.pose.bones if pb.name in plain.motion.bone_names or pb.name.startswith("DEF-")]
+    keep = [obj.pose.bones.find(n) for n in names]
+    in_place = _world(bpy, obj, frames)[:, keep]
+    root = obj.pose.bones.find("root")
+    for facing in (False, True):
+        reports: list[str] = []
+        moved = bake_take(obj, take, preset="rigify", settings=settings,
+                          options=BakeOptions(**opts, root_motion=True, root_motion_facing=facing),
+                          report=lambda level, msg, seen=reports: seen.append(msg))
+        assert "root" in moved.motion.bone_names and list(moved.motion.extras["locations"]) == ["root"]
+        assert any("root motion on 'root'" in m for m in reports)
+        world = _world(bpy, obj, frames)
+        metres, degrees = _pose_errors(world[:, keep], in_place)
+        assert metres < 1e-4 and degrees < 0.01, (facing, metres, degrees)
+        assert np.linalg.norm(world[-1, root, :2, 3] - world[0, root, :2, 3]) > 0.3   # the root travels
+        np.testing.assert_allclose(world[:, root, 2, 3], 0.0, atol=1e-6)               # on the floor
+        if facing:   # the root turns with the performer
+            assert np.ptp(np.degrees(np.arctan2(world[:, root, 1, 0], world[:, root, 0, 0]))) > 1.0
+        else:
+            np.testing.assert_allclose(world[:, root, :3, :3], np.broadcast_to(np.eye(3), (len(frames), 3, 3)),
+                                       atol=1e-6)
+    # the torso's parent switched away from root: the relation does not verify, a clear refusal
+    obj.pose.bones["torso"]["torso_parent"] = 0
+    with pytest.raises(ValueError, match="do not move rigidly"):
+        bake_take(obj, take, preset="rigify", settings=settings, options=BakeOptions(**opts, root_motion=True))
+    bpy.ops.wm.read_factory_settings(use_empty=True)
