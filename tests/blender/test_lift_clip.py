@@ -121,12 +121,13 @@ def test_cli_lifts_a_blend_with_a_clip(bpy_empty, tmp_path, walk_2d):
 
 
 # H-Anim humanoid bones (named after the H-Anim joint at their head) as the 'hanim' preset expects them:
-# bone -> (head joint, tail joint, parent bone); "Head+" is 10 cm above the head joint.
+# bone -> (head joint, tail joint, parent bone); "Head+" is 10 cm above the head joint. As in the H-Anim
+# standard's hierarchy (ISO/IEC 19774, LOA 2+), the sternoclavicular joints hang from vt1, not vl5.
 HANIM_BONES = {
     "sacroiliac": ("HipCenter", "Spine", None), "vl5": ("Spine", "ShoulderCenter", "sacroiliac"),
     "vt1": ("ShoulderCenter", "Neck", "vl5"), "skullbase": ("Neck", "Head+", "vt1"),
     **{f"{s}_{bone}": (f"{a}{side}", f"{b}{side}", par.format(s=s)) for s, side in (("l", "Left"), ("r", "Right"))
-       for bone, a, b, par in (("sternoclavicular", "Shoulder", "Shoulder", "vl5"),
+       for bone, a, b, par in (("sternoclavicular", "Shoulder", "Shoulder", "vt1"),
                                ("shoulder", "Shoulder", "Elbow", "{s}_sternoclavicular"),
                                ("elbow", "Elbow", "Wrist", "{s}_shoulder"), ("wrist", "Wrist", "Hand", "{s}_elbow"),
                                ("hip", "Hip", "Knee", "sacroiliac"), ("knee", "Knee", "Ankle", "{s}_hip"),
@@ -173,6 +174,21 @@ def test_lift_bakes_onto_an_hanim_humanoid(bpy_empty, tmp_path, walk_2d, shared_
             got = np.array(rig.matrix_world @ pb.tail) - np.array(rig.matrix_world @ pb.head)
             real = kinect_to_blender(pos[frame - 1, KINECT_V1.index(b)] - pos[frame - 1, KINECT_V1.index(a)])
             assert got @ real / np.linalg.norm(got) / np.linalg.norm(real) > np.cos(np.radians(30)), bone
+
+
+def test_hanim_humanoid_renamed_maps_by_structure_as_its_preset(bpy_empty, shared_data):
+    """The same armature with every bone renamed at random: structure finds the 'hanim' preset's mapping."""
+    from kinect_retarget.core.armature_mapping import structure_mapping_for
+    from kinect_retarget.core.presets import PRESETS
+    from tests.rigs.humanoid_rigs import Rig, renamed
+    rig = _hanim_rig(bpy_empty, bvh.read(shared_data / "mocap_bvh" / "01_01.bvh").positions[0])
+    bones = list(rig.data.bones)
+    names = [b.name for b in bones]
+    plain = Rig(names, np.array([names.index(b.parent.name) if b.parent else -1 for b in bones]),
+                np.array([b.head_local for b in bones]), np.array([b.tail_local for b in bones]))
+    anon, back = renamed(plain, 7)
+    found = structure_mapping_for(anon.names, anon.parents, anon.heads, anon.tails).mapping
+    assert {back[b]: j for b, j in found.items()} == {b: j for b, j in PRESETS["hanim"].items() if b in names}
 
 
 def test_joint_tracker_writes_clip_markers(registered, tmp_path, shared_data):

@@ -112,3 +112,30 @@ def test_take_baked_by_structure_follows_the_performer(family, hop):
         src = normalize(p[:, m.tail] - p[:, m.head])
         err = np.degrees(np.arccos(np.clip(np.sum(src * posed[:, m.index, :3, 1], -1), -1, 1)))
         assert err.max() < 1e-3, (family, m.bone, m.tail_name)
+
+
+def _hanim_rig() -> Rig:
+    """A small H-Anim humanoid (bones named after the joint at their head), with the standard's hierarchy
+    (ISO/IEC 19774, LOA 2+, intermediate vertebrae left out as the standard allows): vl5 -> vt1 -> skullbase, and
+    the sternoclavicular joints hang from vt1 (the test armature in tests/blender/test_lift_clip.py likewise)."""
+    from tests.rigs.humanoid_rigs import ANKLE, BALL, CLAV, ELBOW, HIP, HIPS, KNEE, KNUCKLE, NECK_BASE, \
+        SHOULDER, SKULL, TOP, WRIST
+    bones = [("sacroiliac", None, HIPS, (0, 0, 1.2)), ("vl5", "sacroiliac", (0, 0, 1.2), NECK_BASE),
+             ("vt1", "vl5", NECK_BASE, SKULL), ("skullbase", "vt1", SKULL, TOP)]
+    for s, x in (("l_", 1.0), ("r_", -1.0)):
+        m = lambda p: (p[0] * x, p[1], p[2])  # noqa: E731
+        bones += [(f"{s}sternoclavicular", "vt1", m(CLAV), m(SHOULDER)),
+                  (f"{s}shoulder", f"{s}sternoclavicular", m(SHOULDER), m(ELBOW)),
+                  (f"{s}elbow", f"{s}shoulder", m(ELBOW), m(WRIST)), (f"{s}wrist", f"{s}elbow", m(WRIST), m(KNUCKLE)),
+                  (f"{s}hip", "sacroiliac", m(HIP), m(KNEE)), (f"{s}knee", f"{s}hip", m(KNEE), m(ANKLE)),
+                  (f"{s}ankle", f"{s}knee", m(ANKLE), m(BALL))]
+    names = [b[0] for b in bones]
+    parents = np.array([names.index(b[1]) if b[1] else -1 for b in bones])
+    return Rig(names, parents, np.array([b[2] for b in bones], float), np.array([b[3] for b in bones], float))
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_hanim_armature_renamed_maps_as_its_preset(seed):
+    rig = _hanim_rig()
+    assert detect_preset(rig.names) == "hanim"
+    assert _by_structure(rig, seed) == _preset(rig, "hanim")
