@@ -1,4 +1,4 @@
-"""Shared fixtures. Real data: the repository's tests/data (see tests/data/CREDITS.md), served by `shared_data`
+"""Shared fixtures. Real data: the repository's tests/data (see tests/data/CREDITS.md), served by `data_dir`
 at the same sub-paths as in the workshop's shared/data folder."""
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ def pytest_collection_modifyitems(config, items):
 
 
 @pytest.fixture(scope="session")
-def shared_data(tmp_path_factory) -> Path:
+def data_dir(tmp_path_factory) -> Path:
     """tests/data, gzipped files decompressed, laid out like shared/data (tests/repo_data.py)."""
     from tests.repo_data import materialize
     return materialize(tmp_path_factory.mktemp("data"))

@@ -73,10 +73,10 @@ def test_nothing_research_only_is_tracked():
     assert "utd_mhad" not in tracked.lower() and "utd-mhad" not in tracked.lower()
 
 
-def test_the_simulator_clip_is_the_first_three_seconds_of_cmu_131_03(shared_data):
+def test_the_simulator_clip_is_the_first_three_seconds_of_cmu_131_03(data_dir):
     from kinect_retarget.sim.bvh_motion import read_bvh_positions
     names, parents, cut, dt = read_bvh_positions(motion_clip("131_03"))
-    names_full, parents_full, full, dt_full = read_bvh_positions(shared_data / "mocap_bvh" / "131_03.bvh")
+    names_full, parents_full, full, dt_full = read_bvh_positions(data_dir / "mocap_bvh" / "131_03.bvh")
     assert (names, list(parents), dt) == (names_full, list(parents_full), dt_full)
     assert len(cut) == 360                            # 90 frames at 30 fps: what the simulated Kinect renders
     np.testing.assert_array_equal(cut, full[:360])

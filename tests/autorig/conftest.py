@@ -5,5 +5,5 @@ from kinect_retarget.sim.autorig_scoring import load_makehuman
 
 
 @pytest.fixture(scope="session")
-def mh(shared_data):
-    return load_makehuman(shared_data / "meshes" / "makehuman")
+def mh(data_dir):
+    return load_makehuman(data_dir / "meshes" / "makehuman")

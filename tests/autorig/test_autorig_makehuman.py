@@ -65,8 +65,8 @@ def test_labels_in_any_orientation_and_scale(mh, rest_rig, case, rng):
     assert np.abs(rig.joints - expected).max() < 1e-6 * scale * mh.height + 1e-9
 
 
-def test_extreme_pose(mh, shared_data):
-    motion = read_bvh_skeleton(shared_data / "meshes" / "makehuman" / "benchmark.bvh")
+def test_extreme_pose(mh, data_dir):
+    motion = read_bvh_skeleton(data_dir / "meshes" / "makehuman" / "benchmark.bvh")
     rot = rotations_from_makehuman_bvh(mh, motion)
     posed = pose_body(mh, rot)
     rig = autorig(posed)
@@ -79,8 +79,8 @@ def test_extreme_pose(mh, shared_data):
 # Frames of the held-out CMU clips (the method was developed on 131_01/131_02): the worst frame of the
 # previous method (01_01, a hip 4.1 % off) and a stride of 131_03.
 @pytest.mark.parametrize("clip, frame", [("01_01", 2063), ("131_03", 550)])
-def test_held_out_cmu_frames(mh, shared_data, clip, frame):
-    motion = read_bvh_skeleton(shared_data / "mocap_bvh" / f"{clip}.bvh")
+def test_held_out_cmu_frames(mh, data_dir, clip, frame):
+    motion = read_bvh_skeleton(data_dir / "mocap_bvh" / f"{clip}.bvh")
     rot = rotations_from_cmu(mh, motion, frame)
     rig = autorig(pose_body(mh, rot))
     err = joint_errors(rig.joints, reference_joints(mh, rot), mh.height)

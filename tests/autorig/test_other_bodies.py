@@ -19,9 +19,9 @@ BODIES = ("reshaped, one-sided diagonals", "decimated to 7k vertices", "random d
 
 
 @pytest.fixture(scope="module")
-def bodies(mh, shared_data):
+def bodies(mh, data_dir):
     y = mh.body.vertices[:, 1]
-    rot = rotations_from_makehuman_bvh(mh, read_bvh_skeleton(shared_data / "meshes" / "makehuman" / "tpose.bvh"))
+    rot = rotations_from_makehuman_bvh(mh, read_bvh_skeleton(data_dir / "meshes" / "makehuman" / "tpose.bvh"))
     ref = reference_joints(mh)
     return {  # name: (mesh, its reference joints)
         BODIES[0]: (one_sided_diagonals(reshaped(mh.body)), reshape_points(ref, (y.min(), y.max()))),
@@ -66,9 +66,9 @@ def test_the_asymmetry_came_from_the_triangulation(rigs):
     assert rigs[BODIES[0]].report["mirror"]["joint_asymmetry_found_pct"] > 1.5
 
 
-def test_posed_body_is_left_as_found(mh, shared_data):
+def test_posed_body_is_left_as_found(mh, data_dir):
     """A body in an asymmetric pose is not its own mirror image: its joints follow the pose."""
-    rot = rotations_from_makehuman_bvh(mh, read_bvh_skeleton(shared_data / "meshes" / "makehuman" / "benchmark.bvh"))
+    rot = rotations_from_makehuman_bvh(mh, read_bvh_skeleton(data_dir / "meshes" / "makehuman" / "benchmark.bvh"))
     rig = autorig(pose_body(mh, rot))
     assert not rig.report["mirror"]["symmetric"] and rig.report["mirror"]["surface_mismatch_pct"] > 0.5
     assert symmetry_error(rig.joints, LEFT, np.zeros(3), mh.height) > 10

@@ -43,6 +43,6 @@ def test_uneven_triangles_and_t_junctions(mh):
     _check(mh, once)
 
 
-def test_t_pose(mh, shared_data):
-    rot = rotations_from_makehuman_bvh(mh, read_bvh_skeleton(shared_data / "meshes" / "makehuman" / "tpose.bvh"))
+def test_t_pose(mh, data_dir):
+    rot = rotations_from_makehuman_bvh(mh, read_bvh_skeleton(data_dir / "meshes" / "makehuman" / "tpose.bvh"))
     _check(mh, pose_body(mh, rot), reference_joints(mh, rot))

@@ -6,10 +6,10 @@ import pytest
 from kinect_retarget.cli import main
 
 
-def test_autorig_cli_bakes_and_renders(shared_data, tmp_path, capsys):
+def test_autorig_cli_bakes_and_renders(data_dir, tmp_path, capsys):
     out = tmp_path / "mh.blend"
-    code = main(["autorig", str(shared_data / "meshes" / "makehuman" / "base.obj"), "--group", "body",
-                 "--out", str(out), "--take", str(shared_data / "kinect_v2" / "Ges04_comehere.csv"),
+    code = main(["autorig", str(data_dir / "meshes" / "makehuman" / "base.obj"), "--group", "body",
+                 "--out", str(out), "--take", str(data_dir / "kinect_v2" / "Ges04_comehere.csv"),
                  "--render", str(tmp_path / "png"), "--frames", "2"])
     assert code == 0
     summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
@@ -36,14 +36,14 @@ def test_autorig_cli_bad_input(tmp_path, capsys, content, message):
 
 
 @pytest.mark.parametrize("fmt", ["glb", "ply"])
-def test_blender_exported_files_rig_like_the_source(bpy_empty, shared_data, tmp_path, fmt):
+def test_blender_exported_files_rig_like_the_source(bpy_empty, data_dir, tmp_path, fmt):
     """GLB (Y-up by the glTF spec) and PLY (Z-up) written by Blender itself load and rig to the same joints."""
     import numpy as np
 
     from kinect_retarget.autorig import autorig, load_mesh
     from kinect_retarget.blender.mesh_autorig import new_mesh_object
     bpy = bpy_empty
-    src = load_mesh(shared_data / "meshes" / "makehuman" / "base.obj", group="body")
+    src = load_mesh(data_dir / "meshes" / "makehuman" / "base.obj", group="body")
     z_up = src.vertices @ np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], float).T * 0.1
     obj = new_mesh_object("Body", z_up, src.faces, bpy.context.scene.collection)
     obj.select_set(True)
@@ -60,10 +60,10 @@ def test_blender_exported_files_rig_like_the_source(bpy_empty, shared_data, tmp_
     np.testing.assert_allclose(rig.joints, ref.joints, atol=2e-4)
 
 
-def test_autorig_cli_refuses_levels_that_change_nothing(shared_data, tmp_path, capsys):
+def test_autorig_cli_refuses_levels_that_change_nothing(data_dir, tmp_path, capsys):
     """--levels moves nothing under the fractions rule: refused unless the paper's points are used."""
     out = tmp_path / "o.blend"
-    mesh = str(shared_data / "meshes" / "makehuman" / "base.obj")
+    mesh = str(data_dir / "meshes" / "makehuman" / "base.obj")
     assert main(["autorig", mesh, "--group", "body", "--out", str(out), "--levels", "3"]) == 2
     assert "--levels" in capsys.readouterr().err and not out.exists()
     assert main(["autorig", mesh, "--group", "body", "--out", str(out), "--joints", "paper", "--levels", "3",

@@ -9,8 +9,8 @@ Y_UP_TO_Z_UP = np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], dtype=float)  # Blen
 
 
 @pytest.fixture(scope="module")
-def body(shared_data):
-    m = load_mesh(shared_data / "meshes" / "makehuman" / "base.obj", group="body")
+def body(data_dir):
+    m = load_mesh(data_dir / "meshes" / "makehuman" / "base.obj", group="body")
     return m.vertices @ Y_UP_TO_Z_UP.T * 0.1, m.faces  # decimetres -> metres, facing -Y
 
 
@@ -74,14 +74,14 @@ def test_not_a_human_leaves_scene_untouched(registered, shape, message):
     assert bpy.context.active_object.parent is None
 
 
-def test_take_baked_on_autorigged_mesh_deforms_cleanly(registered, body, shared_data):
+def test_take_baked_on_autorigged_mesh_deforms_cleanly(registered, body, data_dir):
     bpy = registered
     from kinect_retarget.blender.mesh_autorig import rig_mesh_object
     from kinect_retarget.blender.bake_take import bake_take
     from kinect_retarget.takes import load_take
     obj = _add_body(bpy, body)
     arm, _, _ = rig_mesh_object(bpy.context, obj)
-    take = load_take(shared_data / "kinect_v2" / "Ges02_balancinghands.csv")
+    take = load_take(data_dir / "kinect_v2" / "Ges02_balancinghands.csv")
     result = bake_take(arm, take, preset="kinect")
     assert result.preset == "kinect"
     rest_edges = _edge_lengths(obj.data)

@@ -33,10 +33,10 @@ def _check_directions(bpy, obj, motion, take, pairs, every=1):
 
 
 @pytest.mark.parametrize("take_path", ["kinect_v2/Ges02_balancinghands.csv", "mocap_bvh/131_01.bvh"])
-def test_generated_rig_round_trip(bpy_empty, shared_data, take_path):
+def test_generated_rig_round_trip(bpy_empty, data_dir, take_path):
     from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
     bpy = bpy_empty
-    take = load_take(shared_data / take_path)
+    take = load_take(data_dir / take_path)
     if take.frame_count > 300:
         take = take.slice(slice(0, 300))
     obj = new_generated_rig(bpy.context.scene, take)
@@ -65,10 +65,10 @@ def test_generated_rig_round_trip(bpy_empty, shared_data, take_path):
     np.testing.assert_allclose(heads - heads[0], src - src[0], atol=1e-4)
 
 
-def test_rig_is_not_edited(bpy_empty, shared_data):
+def test_rig_is_not_edited(bpy_empty, data_dir):
     from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
     bpy = bpy_empty
-    take = load_take(shared_data / "kinect_v2" / "Ges04_comehere.csv")
+    take = load_take(data_dir / "kinect_v2" / "Ges04_comehere.csv")
     obj = new_generated_rig(bpy.context.scene, take)
     before = [(b.name, tuple(map(tuple, b.matrix_local)), b.use_inherit_rotation, b.parent and b.parent.name)
               for b in obj.data.bones]
@@ -78,12 +78,12 @@ def test_rig_is_not_edited(bpy_empty, shared_data):
     assert before == after
 
 
-def test_rigify_generated_rig_limbs_follow(shared_data, rigify_rig_path):
+def test_rigify_generated_rig_limbs_follow(data_dir, rigify_rig_path):
     import bpy
     from kinect_retarget.blender.bake_take import bake_take
     bpy.ops.wm.open_mainfile(filepath=str(rigify_rig_path))
     obj = bpy.data.objects["rig"]
-    take = load_take(shared_data / "kinect_v2" / "Ges01_wavehand.csv").slice(slice(0, 40))
+    take = load_take(data_dir / "kinect_v2" / "Ges01_wavehand.csv").slice(slice(0, 40))
     res = bake_take(obj, take, preset="auto",
                    settings=RetargetSettings(filter="none", fps=take.rate))  # keys on the take's samples
     assert res.preset == "rigify"
@@ -100,10 +100,10 @@ def test_rigify_generated_rig_limbs_follow(shared_data, rigify_rig_path):
     bpy.ops.wm.read_factory_settings(use_empty=True)
 
 
-def test_operator_bakes_onto_active_armature(registered, shared_data):
+def test_operator_bakes_onto_active_armature(registered, data_dir):
     from kinect_retarget.blender.bake_take import new_generated_rig
     bpy = registered
-    take_path = shared_data / "kinect_v2" / "Ges05_demopoint.csv"
+    take_path = data_dir / "kinect_v2" / "Ges05_demopoint.csv"
     obj = new_generated_rig(bpy.context.scene, load_take(take_path))
     bpy.context.view_layer.objects.active = obj
     result = bpy.ops.kinect_retarget.bake_take(filepath=str(take_path), preset="kinect", fps=24.0)
@@ -141,8 +141,8 @@ def _tiny_take(skeleton):
     return Take(skeleton, np.repeat(pos[None], 3, 0), np.full((3, len(skeleton)), 2), np.arange(3) / 30, 30.0)
 
 
-def test_cli_bake_and_info(shared_data, tmp_path):
-    take = shared_data / "mocap_bvh" / "131_03.bvh"
+def test_cli_bake_and_info(data_dir, tmp_path):
+    take = data_dir / "mocap_bvh" / "131_03.bvh"
     out = tmp_path / "hop.blend"
     info = subprocess.run([sys.executable, "-m", "kinect_retarget", "info", str(take), "--json"],
                           capture_output=True, text=True, check=True)
@@ -156,14 +156,14 @@ def test_cli_bake_and_info(shared_data, tmp_path):
     assert bad.returncode == 2 and "missing.csv" in bad.stderr
 
 
-def test_rigify_metarig_preset(bpy_empty, shared_data):
+def test_rigify_metarig_preset(bpy_empty, data_dir):
     import addon_utils
     from kinect_retarget.blender.bake_take import bake_take
     bpy = bpy_empty
     addon_utils.enable("rigify", default_set=True)
     bpy.ops.object.armature_human_metarig_add()
     obj = bpy.context.object
-    take = load_take(shared_data / "mocap_bvh" / "01_01.bvh").slice(slice(0, 480, 4))
+    take = load_take(data_dir / "mocap_bvh" / "01_01.bvh").slice(slice(0, 480, 4))
     res = bake_take(obj, take, preset="auto",
                    settings=RetargetSettings(filter="none", fps=take.rate),  # keys on the take's samples
                    options=SOLVER_ONLY)
@@ -175,12 +175,12 @@ def test_rigify_metarig_preset(bpy_empty, shared_data):
     assert errs.max() < 0.5
 
 
-def test_cli_mapping_override_unmaps_bones(shared_data, tmp_path):
+def test_cli_mapping_override_unmaps_bones(data_dir, tmp_path):
     import json
     mapping = tmp_path / "map.json"
     mapping.write_text(json.dumps({"ElbowLeft": "", "WristLeft": None}))
     out = tmp_path / "wave.blend"
-    take = shared_data / "kinect_v2" / "Ges01_wavehand.csv"
+    take = data_dir / "kinect_v2" / "Ges01_wavehand.csv"
     r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(take), "--out", str(out),
                         "--mapping", str(mapping)], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
@@ -192,10 +192,10 @@ def test_cli_mapping_override_unmaps_bones(shared_data, tmp_path):
     assert r.returncode == 2 and "bad.json" in r.stderr
 
 
-def test_baking_again_keeps_the_previous_action_in_the_file(bpy_empty, shared_data, tmp_path):
+def test_baking_again_keeps_the_previous_action_in_the_file(bpy_empty, data_dir, tmp_path):
     from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
     bpy = bpy_empty
-    take = load_take(shared_data / "kinect_v2" / "Ges02_balancinghands.csv")
+    take = load_take(data_dir / "kinect_v2" / "Ges02_balancinghands.csv")
     obj = new_generated_rig(bpy.context.scene, take)
     first = bake_take(obj, take, preset="kinect", action_name="first").action
     bake_take(obj, take, preset="kinect", action_name="second")
@@ -206,11 +206,11 @@ def test_baking_again_keeps_the_previous_action_in_the_file(bpy_empty, shared_da
     assert first is not None
 
 
-def test_euler_and_axis_angle_bones_are_keyed_in_their_own_channels(bpy_empty, shared_data):
+def test_euler_and_axis_angle_bones_are_keyed_in_their_own_channels(bpy_empty, data_dir):
     """The rig's rotation modes are kept; Blender's evaluation of Euler/axis-angle keys matches the take."""
     from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
     bpy = bpy_empty
-    take = load_take(shared_data / "kinect_v2" / "Ges06_chickenwing.csv")
+    take = load_take(data_dir / "kinect_v2" / "Ges06_chickenwing.csv")
     obj = new_generated_rig(bpy.context.scene, take)
     modes = {"ElbowLeft": "ZXY", "WristLeft": "XYZ", "ElbowRight": "AXIS_ANGLE", "KneeLeft": "YZX"}
     for bone, mode in modes.items():
@@ -228,10 +228,10 @@ def test_euler_and_axis_angle_bones_are_keyed_in_their_own_channels(bpy_empty, s
     assert errs.max() < 0.5
 
 
-def test_cli_rig_errors_and_visible_armature(bpy_empty, shared_data, tmp_path):
+def test_cli_rig_errors_and_visible_armature(bpy_empty, data_dir, tmp_path):
     from kinect_retarget.blender.bake_take import new_generated_rig
     bpy = bpy_empty
-    take_path = shared_data / "kinect_v2" / "Ges04_comehere.csv"
+    take_path = data_dir / "kinect_v2" / "Ges04_comehere.csv"
     take = load_take(take_path)
     keep = new_generated_rig(bpy.context.scene, take, name="Visible")
     hidden = new_generated_rig(bpy.context.scene, take, name="Hidden")
@@ -256,10 +256,10 @@ def test_cli_rig_errors_and_visible_armature(bpy_empty, shared_data, tmp_path):
     assert r.returncode == 2 and "no armature in the file" in r.stderr and "--armature" not in r.stderr
 
 
-def test_operator_uses_the_sidebar_target_and_mapping_table(registered, shared_data):
+def test_operator_uses_the_sidebar_target_and_mapping_table(registered, data_dir):
     from kinect_retarget.blender.bake_take import new_generated_rig
     bpy = registered
-    take_path = shared_data / "kinect_v2" / "Ges05_demopoint.csv"
+    take_path = data_dir / "kinect_v2" / "Ges05_demopoint.csv"
     take = load_take(take_path)
     target = new_generated_rig(bpy.context.scene, take, name="Target")
     other = new_generated_rig(bpy.context.scene, take, name="Other")
@@ -276,13 +276,13 @@ def test_operator_uses_the_sidebar_target_and_mapping_table(registered, shared_d
     assert 'pose.bones["WristLeft"].rotation_quaternion' in paths
 
 
-def test_root_scale_from_the_operator_and_the_cli(registered, shared_data, tmp_path):
+def test_root_scale_from_the_operator_and_the_cli(registered, data_dir, tmp_path):
     """Paper 000 eq. 13's n: 0 = auto (1 on a generated rig); 2 doubles the root's travel. The CLI takes a
     number or 'auto' and refuses anything else before Blender starts."""
     from kinect_retarget.blender.bake_take import new_generated_rig
     from kinect_retarget.cli import main
     bpy = registered
-    take_path = shared_data / "kinect_v2" / "Ges05_demopoint.csv"
+    take_path = data_dir / "kinect_v2" / "Ges05_demopoint.csv"
     travel = {}
     for n in (0.0, 2.0):
         bpy.ops.wm.read_factory_settings(use_empty=True)

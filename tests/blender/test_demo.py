@@ -18,9 +18,9 @@ WAVE_FRAME = 60  # Ges01: the performer's right hand is up, waving, around here
 
 
 @pytest.fixture
-def baked_rig(shared_data):
+def baked_rig(data_dir):
     """Generated Kinect rig with the first 70 frames of a real Kinect v2 take baked on it."""
-    take = kinect_v2_csv.read(shared_data / "kinect_v2" / "Ges01_wavehand.csv").slice(slice(0, 70))
+    take = kinect_v2_csv.read(data_dir / "kinect_v2" / "Ges01_wavehand.csv").slice(slice(0, 70))
     bpy.ops.wm.read_factory_settings(use_empty=True)
     obj = new_generated_rig(bpy.context.scene, take)
     bake_take(obj, take, preset="kinect")
@@ -149,11 +149,11 @@ def _demo_module():
     return module
 
 
-def test_demo_tool_bakes_saves_and_renders_and_names_a_bad_take(shared_data, tmp_path, capsys):
+def test_demo_tool_bakes_saves_and_renders_and_names_a_bad_take(data_dir, tmp_path, capsys):
     demo = _demo_module()
     bad = tmp_path / "broken.csv"
     bad.write_text("not,a,take\n")
-    take = shared_data / "mocap_bvh" / "131_03.bvh"
+    take = data_dir / "mocap_bvh" / "131_03.bvh"
     status = demo.main(["--out", str(tmp_path / "out"), "--takes", str(bad), str(take), "--no-rigify",
                         "--stills", "2", "--resolution", "160x120"])
     printed = capsys.readouterr().out

@@ -86,7 +86,7 @@ def test_install_enable_bake_disable_in_the_bpy_extension_repository(extension_z
     assert (tmp_path / "blender_user").is_dir()  # it went to the child's own BLENDER_USER_RESOURCES
 
 
-def test_register_unregister_three_times_leaves_nothing(shared_data, tmp_path):
+def test_register_unregister_three_times_leaves_nothing(data_dir, tmp_path):
     """In process, the plain package: cycles with live running in between."""
     import bpy
     import kinect_retarget

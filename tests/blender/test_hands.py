@@ -60,9 +60,9 @@ def _thumb_side_errors(bpy, obj, res, take):
     return np.array(errs)
 
 
-def test_v2_hands_roll_to_the_thumb_and_curl_from_hand_states(metarig, shared_data):
+def test_v2_hands_roll_to_the_thumb_and_curl_from_hand_states(metarig, data_dir):
     bpy = __import__("bpy")
-    take = load_take(shared_data / "kinect_v2" / "recorded_skeleton.json")
+    take = load_take(data_dir / "kinect_v2" / "recorded_skeleton.json")
     assert take.hand_states is not None
     rest_tilt = _toward_palm(metarig, "hand.L", "Left", "f_middle.01.L")
     res, msg = _bake(metarig, take)
@@ -151,18 +151,18 @@ def test_live_hands_equal_the_bake_of_the_recording(metarig, tmp_path):
         kinect_retarget.unregister()
 
 
-def test_mixamo_named_fingers_on_a_real_skeleton(bpy_empty, shared_data):
+def test_mixamo_named_fingers_on_a_real_skeleton(bpy_empty, data_dir):
     """MakeHuman's skeleton (its own A-pose hands and bone rolls) under Mixamo's names, fingers included."""
     from .test_makehuman_rig import RENAMES, build_makehuman_armature
     bpy = bpy_empty
-    obj = build_makehuman_armature(bpy, shared_data)
+    obj = build_makehuman_armature(bpy, data_dir)
     names = dict(RENAMES["mixamo"])
     for s, side in (("L", "Left"), ("R", "Right")):
         for n, finger in enumerate(("Thumb", "Index", "Middle", "Ring", "Pinky"), start=1):
             names.update({f"finger{n}-{i}.{s}": f"mixamorig:{side}Hand{finger}{i}" for i in (1, 2, 3)})
     for old, new in names.items():
         obj.data.bones[old].name = new
-    take = load_take(shared_data / "kinect_v2" / "recorded_skeleton.json")
+    take = load_take(data_dir / "kinect_v2" / "recorded_skeleton.json")
     rest_tilt = _toward_palm(obj, "mixamorig:LeftHand", "Left", "mixamorig:LeftHandMiddle1")
     res, msg = _bake(obj, take)
     assert res.preset == "mixamo" and "hands: 30 finger bones keyed" in msg

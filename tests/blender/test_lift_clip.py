@@ -21,8 +21,8 @@ TRACK_NAMES = {"HipLeft": "l_hip", "HipRight": "RHip", "KneeLeft": "left knee", 
 
 
 @pytest.fixture(scope="module")
-def walk_2d(shared_data):
-    take = bvh.read(shared_data / "mocap_bvh" / "131_02.bvh")
+def walk_2d(data_dir):
+    take = bvh.read(data_dir / "mocap_bvh" / "131_02.bvh")
     pos = take.positions[::4][135:195]  # two seconds of walking at 30 fps
     pos = view_points(pos, 30.0, 5.0, 4.0, pos[:, 0].mean(axis=0))
     return pos, Camera.for_image(W, H, FOCAL).project(pos)
@@ -157,12 +157,12 @@ def _hanim_rig(bpy, rest_kinect: np.ndarray):
     return obj
 
 
-def test_lift_bakes_onto_an_hanim_humanoid(bpy_empty, tmp_path, walk_2d, shared_data):
+def test_lift_bakes_onto_an_hanim_humanoid(bpy_empty, tmp_path, walk_2d, data_dir):
     from kinect_retarget.blender.clip_lift import lift_clip_and_bake
     bpy = bpy_empty
     pos, uv = walk_2d
     clip = _clip(bpy, tmp_path, uv)
-    rest = bvh.read(shared_data / "mocap_bvh" / "01_01.bvh").positions[0]
+    rest = bvh.read(data_dir / "mocap_bvh" / "01_01.bvh").positions[0]
     rig = _hanim_rig(bpy, rest)
     out = lift_clip_and_bake(bpy.context, clip, rig.name, preset="auto")
     assert out.preset == "hanim"
@@ -176,12 +176,12 @@ def test_lift_bakes_onto_an_hanim_humanoid(bpy_empty, tmp_path, walk_2d, shared_
             assert got @ real / np.linalg.norm(got) / np.linalg.norm(real) > np.cos(np.radians(30)), bone
 
 
-def test_hanim_humanoid_renamed_maps_by_structure_as_its_preset(bpy_empty, shared_data):
+def test_hanim_humanoid_renamed_maps_by_structure_as_its_preset(bpy_empty, data_dir):
     """The same armature with every bone renamed at random: structure finds the 'hanim' preset's mapping."""
     from kinect_retarget.core.armature_mapping import structure_mapping_for
     from kinect_retarget.core.presets import PRESETS
     from tests.rigs.humanoid_rigs import Rig, renamed
-    rig = _hanim_rig(bpy_empty, bvh.read(shared_data / "mocap_bvh" / "01_01.bvh").positions[0])
+    rig = _hanim_rig(bpy_empty, bvh.read(data_dir / "mocap_bvh" / "01_01.bvh").positions[0])
     bones = list(rig.data.bones)
     names = [b.name for b in bones]
     plain = Rig(names, np.array([names.index(b.parent.name) if b.parent else -1 for b in bones]),
@@ -191,12 +191,12 @@ def test_hanim_humanoid_renamed_maps_by_structure_as_its_preset(bpy_empty, share
     assert {back[b]: j for b, j in found.items()} == {b: j for b, j in PRESETS["hanim"].items() if b in names}
 
 
-def test_joint_tracker_writes_clip_markers(registered, tmp_path, shared_data):
+def test_joint_tracker_writes_clip_markers(registered, tmp_path, data_dir):
     """Paper 004's tracker inside Blender: markers on frame 1 of an image-sequence clip of a rendered
     coloured body (real motion), followed through the clip."""
     from kinect_retarget.sim.body_imagery import background, render
     bpy = registered
-    take = bvh.read(shared_data / "mocap_bvh" / "131_02.bvh")
+    take = bvh.read(data_dir / "mocap_bvh" / "131_02.bvh")
     pos = view_points(take.positions[::4][150:165], 80.0, 5.0, 3.5, take.positions[600, 0])
     size, cam = (320, 240), Camera.for_image(320, 240, 300.0)
     rng = np.random.default_rng(4)

@@ -41,9 +41,9 @@ def registered():
 
 
 @pytest.fixture
-def scene_with_rig(registered, shared_data, tmp_path):
+def scene_with_rig(registered, data_dir, tmp_path):
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    take = _csv_take(shared_data / "kinect_v2" / "Ges01_wavehand.csv", frames=90)
+    take = _csv_take(data_dir / "kinect_v2" / "Ges01_wavehand.csv", frames=90)
     path = tmp_path / "wave.krtake"
     krtake.write(path, take)
     scene = bpy.context.scene

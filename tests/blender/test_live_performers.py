@@ -26,10 +26,10 @@ from tests.takes.two_performers import performers, write_two_person_ntu
 
 
 @pytest.fixture
-def two_rigs(shared_data):
+def two_rigs(data_dir):
     kinect_retarget.register()
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    first, second = performers(shared_data)
+    first, second = performers(data_dir)
     second.positions[..., 0] += 1.0  # as the two-person take has it
     scene = bpy.context.scene
     rigs = [build_kinect_rig(scene, KINECT_V2, median_segment_lengths(t), name)
@@ -99,9 +99,9 @@ def test_osc_with_two_users_drives_two_rigs(two_rigs, tmp_path):
     assert not [t for t in threading.enumerate() if t.name.startswith("kinect_retarget") and t.is_alive()]
 
 
-def test_a_two_person_take_from_the_sidebar_drives_each_rig_with_its_body(two_rigs, shared_data, tmp_path):
+def test_a_two_person_take_from_the_sidebar_drives_each_rig_with_its_body(two_rigs, data_dir, tmp_path):
     scene, (alice, bob), (first, second) = two_rigs
-    path = write_two_person_ntu(shared_data, tmp_path / "S001C001P001R001A050.skeleton")
+    path = write_two_person_ntu(data_dir, tmp_path / "S001C001P001R001A050.skeleton")
     s = scene.kinect_retarget
     s.initialised = True
     s.source, s.take_path, s.speed, s.loop, s.armature, s.body = "TAKE", str(path), 4.0, False, alice, 0
@@ -122,9 +122,9 @@ def test_a_two_person_take_from_the_sidebar_drives_each_rig_with_its_body(two_ri
         assert np.abs(got.positions[-1] - other.positions[-1]).max() > 0.5
 
 
-def test_bake_take_bakes_each_body_onto_its_rig(two_rigs, shared_data, tmp_path):
+def test_bake_take_bakes_each_body_onto_its_rig(two_rigs, data_dir, tmp_path):
     scene, (alice, bob), _ = two_rigs
-    path = write_two_person_ntu(shared_data, tmp_path / "S001C001P001R001A050.skeleton")
+    path = write_two_person_ntu(data_dir, tmp_path / "S001C001P001R001A050.skeleton")
     s = scene.kinect_retarget
     s.initialised = True
     s.armature = alice

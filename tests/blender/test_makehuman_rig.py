@@ -53,12 +53,12 @@ def build_makehuman_armature(bpy, data):
     return obj
 
 
-def test_bake_onto_makehuman_skeleton(bpy_empty, shared_data):
+def test_bake_onto_makehuman_skeleton(bpy_empty, data_dir):
     from kinect_retarget.blender.bake_take import bake_take
     bpy = bpy_empty
-    obj = build_makehuman_armature(bpy, shared_data)
+    obj = build_makehuman_armature(bpy, data_dir)
     rest_before = np.array([np.array(b.matrix_local) for b in obj.data.bones])
-    take = load_take(shared_data / "mocap_bvh" / "131_02.bvh").slice(slice(0, 240, 4))
+    take = load_take(data_dir / "mocap_bvh" / "131_02.bvh").slice(slice(0, 240, 4))
     res = bake_take(obj, take, preset="auto",
                    settings=RetargetSettings(filter="none", fps=take.rate),  # keys on the take's samples
                    options=SOLVER_ONLY)
@@ -99,13 +99,13 @@ RENAMES = {
 
 
 @pytest.mark.parametrize("preset", sorted(RENAMES))
-def test_presets_drive_renamed_skeleton(bpy_empty, shared_data, preset):
+def test_presets_drive_renamed_skeleton(bpy_empty, data_dir, preset):
     from kinect_retarget.blender.bake_take import bake_take
     bpy = bpy_empty
-    obj = build_makehuman_armature(bpy, shared_data)
+    obj = build_makehuman_armature(bpy, data_dir)
     for old, new in RENAMES[preset].items():
         obj.data.bones[old].name = new
-    take = load_take(shared_data / "kinect_v2" / "Ges03_drawlines.csv")
+    take = load_take(data_dir / "kinect_v2" / "Ges03_drawlines.csv")
     res = bake_take(obj, take, preset="auto",
                    settings=RetargetSettings(filter="none", fps=take.rate))  # keys on the take's samples
     assert res.preset == preset

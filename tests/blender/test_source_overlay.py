@@ -37,10 +37,10 @@ def test_the_draw_handler_comes_and_goes_with_the_add_on():
 
 
 @pytest.fixture
-def scene(shared_data, tmp_path):
+def scene(data_dir, tmp_path):
     kinect_retarget.register()
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    path = write_two_person_ntu(shared_data, tmp_path / "S001C001P001R001A050.skeleton")
+    path = write_two_person_ntu(data_dir, tmp_path / "S001C001P001R001A050.skeleton")
     takes = load_take(path), load_take(path, body=1)
     sc = bpy.context.scene
     rigs = [build_kinect_rig(sc, KINECT_V2, median_segment_lengths(t), n) for t, n in zip(takes, ("Alice", "Bob"))]

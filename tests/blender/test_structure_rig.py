@@ -23,7 +23,7 @@ def _renamed_metarig(bpy):
     return obj, back
 
 
-def test_renamed_metarig_maps_by_structure_prints_and_bakes(bpy_empty, tmp_path, shared_data):
+def test_renamed_metarig_maps_by_structure_prints_and_bakes(bpy_empty, tmp_path, data_dir):
     from kinect_retarget.blender.bake_take import bake_take
     from kinect_retarget.core.pipeline import RetargetSettings
     from kinect_retarget.takes import load_take
@@ -41,7 +41,7 @@ def test_renamed_metarig_maps_by_structure_prints_and_bakes(bpy_empty, tmp_path,
     text = subprocess.run([sys.executable, "-m", "kinect_retarget", "info", "--rig", str(path)],
                           capture_output=True, text=True, timeout=300).stdout
     assert "structure" in text and "ElbowLeft" in text
-    take = load_take(shared_data / "kinect_v2" / "Ges01_wavehand.csv").slice(slice(0, 60))
+    take = load_take(data_dir / "kinect_v2" / "Ges01_wavehand.csv").slice(slice(0, 60))
     res = bake_take(obj, take, preset="auto", settings=RetargetSettings(filter="none", fps=take.rate))
     assert res.preset == "structure"
     assert {back[b] for b in res.motion.bone_names} >= {"upper_arm.L", "forearm.R", "thigh.L", "spine"}

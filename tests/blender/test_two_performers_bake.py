@@ -41,11 +41,11 @@ def _limb_errors(bpy, obj, take, first_frame):
 
 
 @pytest.fixture
-def two_person_take(shared_data, tmp_path):
-    return write_two_person_ntu(shared_data, tmp_path / "S001C001P001R001A050.skeleton")
+def two_person_take(data_dir, tmp_path):
+    return write_two_person_ntu(data_dir, tmp_path / "S001C001P001R001A050.skeleton")
 
 
-def test_body_all_bakes_each_body_onto_a_generated_rig(bpy_empty, shared_data, tmp_path, two_person_take):
+def test_body_all_bakes_each_body_onto_a_generated_rig(bpy_empty, data_dir, tmp_path, two_person_take):
     bpy = bpy_empty
     out = tmp_path / "duo.blend"
     rc, stdout, stderr = _cli("bake", two_person_take, "--out", out, "--body", "all", "--filter", "none",
@@ -56,7 +56,7 @@ def test_body_all_bakes_each_body_onto_a_generated_rig(bpy_empty, shared_data, t
     assert [p["body"] for p in result["performers"]] == [0, 1]
     assert [p["armature"] for p in result["performers"]] == ["KinectRig_body0", "KinectRig_body1"]
     bpy.ops.wm.open_mainfile(filepath=str(out))
-    first, second = performers(shared_data)
+    first, second = performers(data_dir)
     second.positions[..., 0] += 1.0
     start = result["performers"][0]["frame_range"][0]
     a, b = bpy.data.objects["KinectRig_body0"], bpy.data.objects["KinectRig_body1"]
@@ -64,10 +64,10 @@ def test_body_all_bakes_each_body_onto_a_generated_rig(bpy_empty, shared_data, t
     assert _limb_errors(bpy, a, second, start) > 5 and _limb_errors(bpy, b, first, start) > 5
 
 
-def test_armature_body_pairs_bake_onto_the_rigs_of_a_file(bpy_empty, shared_data, tmp_path, two_person_take):
+def test_armature_body_pairs_bake_onto_the_rigs_of_a_file(bpy_empty, data_dir, tmp_path, two_person_take):
     from kinect_retarget.blender.bake_take import new_generated_rig
     bpy = bpy_empty
-    first, second = performers(shared_data)
+    first, second = performers(data_dir)
     for name in ("Alice", "Bob"):
         new_generated_rig(bpy.context.scene, first, name)
     rigs = tmp_path / "rigs.blend"
@@ -88,7 +88,7 @@ def test_armature_body_pairs_bake_onto_the_rigs_of_a_file(bpy_empty, shared_data
     assert _limb_errors(bpy, bob, first, start) > 5
 
 
-def test_bad_performer_arguments_are_named(tmp_path, two_person_take, shared_data):
+def test_bad_performer_arguments_are_named(tmp_path, two_person_take, data_dir):
     rc, _, err = _cli("bake", two_person_take, "--out", tmp_path / "x.blend", "--body", 2)
     assert rc == 2 and "no body 2" in err
     rc, _, err = _cli("bake", two_person_take, "--out", tmp_path / "x.blend", "--rig", tmp_path / "r.blend",
@@ -96,10 +96,10 @@ def test_bad_performer_arguments_are_named(tmp_path, two_person_take, shared_dat
     assert rc == 2 and "2 bodies need 2 --armature" in err
     rc, _, err = _cli("bake", two_person_take, "--out", tmp_path / "x.fbx", "--body", "all")
     assert rc == 2 and "one .blend" in err
-    rc, _, err = _cli("bake", shared_data / "kinect_v2" / "Ges01_wavehand.csv", "--out", tmp_path / "x.blend",
+    rc, _, err = _cli("bake", data_dir / "kinect_v2" / "Ges01_wavehand.csv", "--out", tmp_path / "x.blend",
                       "--body", 1)
     assert rc == 2 and "no body 1" in err
-    rc, _, err = _cli("bake", shared_data / "kinect_v2" / "Ges01_wavehand.csv", "--out", tmp_path / "x.blend",
+    rc, _, err = _cli("bake", data_dir / "kinect_v2" / "Ges01_wavehand.csv", "--out", tmp_path / "x.blend",
                       "--armature", "Nope")  # one body, no --rig: the name would be ignored
     assert rc == 2 and "without --rig" in err
 

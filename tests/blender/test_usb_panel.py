@@ -31,9 +31,9 @@ PREVIEW_W, PREVIEW_H = 320, 240
 
 
 @pytest.fixture(scope="module")
-def fakenect_frames(shared_data):
+def fakenect_frames(data_dir):
     """Six real Kinect v1 depth frames (libfreenect recording of a person)."""
-    return load_fakenect_dir(shared_data.joinpath(*FAKENECT), limit=6)
+    return load_fakenect_dir(data_dir.joinpath(*FAKENECT), limit=6)
 
 
 @pytest.fixture

@@ -10,15 +10,15 @@ REAL = ["Ges01_wavehand.csv", "Ges02_balancinghands.csv", "Ges03_drawlines.csv",
 
 
 @pytest.mark.parametrize("name", REAL)
-def test_default_filter_halves_jitter_within_one_frame_of_lag(shared_data, name):
-    take = load_take(shared_data / "kinect_v2" / name)
+def test_default_filter_halves_jitter_within_one_frame_of_lag(data_dir, name):
+    take = load_take(data_dir / "kinect_v2" / name)
     out = make_filter("default", take.rate).run(take.positions, take.states, take.times)
     assert jitter(out) <= 0.5 * jitter(take.positions)
     assert lag_frames(take.positions, out) <= 1.0
 
 
-def test_step_and_run_agree(shared_data):
-    take = load_take(shared_data / "kinect_v2" / "Ges03_drawlines.csv")
+def test_step_and_run_agree(data_dir):
+    take = load_take(data_dir / "kinect_v2" / "Ges03_drawlines.csv")
     for make in (OneEuroFilter, DoubleExponentialFilter):
         batch = make().run(take.positions, take.states, take.times)
         f = make()
@@ -26,8 +26,8 @@ def test_step_and_run_agree(shared_data):
         np.testing.assert_array_equal(batch, live)
 
 
-def test_untracked_joints_hold_and_restart(shared_data):
-    take = load_take(shared_data / "kinect_v2" / "Ges01_wavehand.csv")
+def test_untracked_joints_hold_and_restart(data_dir):
+    take = load_take(data_dir / "kinect_v2" / "Ges01_wavehand.csv")
     states = take.states.copy()
     positions = take.positions.copy()
     states[50:60, 7] = 0

@@ -14,13 +14,13 @@ from tests.conftest import assert_quat_equal
 
 
 @pytest.fixture(scope="module")
-def hop(shared_data):
-    return load_take(shared_data / "mocap_bvh" / "131_03.bvh").slice(slice(0, 600))
+def hop(data_dir):
+    return load_take(data_dir / "mocap_bvh" / "131_03.bvh").slice(slice(0, 600))
 
 
 @pytest.fixture(scope="module")
-def wave(shared_data):
-    return load_take(shared_data / "kinect_v2" / "Ges01_wavehand.csv")
+def wave(data_dir):
+    return load_take(data_dir / "kinect_v2" / "Ges01_wavehand.csv")
 
 
 def _direction_errors(pipe, motion, take, rig):
@@ -223,9 +223,9 @@ def test_unmapped_bones_and_inherit_rotation_flags(hop):
                                atol=1e-12)
 
 
-def test_joints_without_positions_never_reach_the_keys(shared_data):
+def test_joints_without_positions_never_reach_the_keys(data_dir):
     """UI-PRMD has no hand joints (NaN, untracked): their bones are left alone, nothing NaN is keyed, live too."""
-    take = load_take(shared_data / "kinect_v2_vicon_uiprmd" / "Kinect" / "m07_s01_e01_positions.txt")
+    take = load_take(data_dir / "kinect_v2_vicon_uiprmd" / "Kinect" / "m07_s01_e01_positions.txt")
     assert np.isnan(take.positions).any()
     rig = generated_rig(take.skeleton, median_segment_lengths(take))
     for flt in ("none", "default"):

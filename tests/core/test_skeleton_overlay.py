@@ -13,8 +13,8 @@ from kinect_retarget.takes import kinect_v2_csv
 
 
 @pytest.fixture(scope="module")
-def take(shared_data):
-    return kinect_v2_csv.read(shared_data / "kinect_v2" / "Ges04_comehere.csv")
+def take(data_dir):
+    return kinect_v2_csv.read(data_dir / "kinect_v2" / "Ges04_comehere.csv")
 
 
 def test_every_bone_is_a_line_from_parent_to_joint(take):

@@ -6,9 +6,9 @@ import pytest
 
 
 @pytest.fixture(scope="session")
-def rendered(shared_data, tmp_path_factory):
+def rendered(data_dir, tmp_path_factory):
     from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence
-    seq = render_sequence(str(shared_data / "mocap_bvh" / "131_03.bvh"), str(shared_data / "meshes" / "makehuman"),
+    seq = render_sequence(str(data_dir / "mocap_bvh" / "131_03.bvh"), str(data_dir / "meshes" / "makehuman"),
                           Scenario(seed=7), start=40, frames=12)
     path = tmp_path_factory.mktemp("depth") / "hop.npz"
     seq.save_npz(str(path))

@@ -18,9 +18,9 @@ HAND_R, ELBOW_R = KINECT_V1.index("HandRight"), KINECT_V1.index("ElbowRight")
 
 
 @pytest.fixture(scope="module")
-def hand_on_face(shared_data):
+def hand_on_face(data_dir):
     from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence
-    return render_sequence(str(shared_data / "mocap_bvh" / "131_02.bvh"), str(shared_data / "meshes" / "makehuman"),
+    return render_sequence(str(data_dir / "mocap_bvh" / "131_02.bvh"), str(data_dir / "meshes" / "makehuman"),
                            Scenario(seed=5), start=400, frames=3)
 
 
@@ -119,11 +119,11 @@ def test_the_head_is_not_arm_evidence(hand_on_face, monkeypatch):
     assert np.mean(ev[near_hand]) > 0.3     # the hand held to the face still counts for its arm
 
 
-def test_well_explained_arms_of_a_performer_facing_the_sensor_are_tracked(shared_data, monkeypatch):
+def test_well_explained_arms_of_a_performer_facing_the_sensor_are_tracked(data_dir, monkeypatch):
     """Walking toward the sensor with the hands hanging (no extremity): once the tracking is steady, the
     search's elbows and wrists that the surface shows are reported tracked, and they are right."""
     from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence
-    seq = render_sequence(str(shared_data / "mocap_bvh" / "131_02.bvh"), str(shared_data / "meshes" / "makehuman"),
+    seq = render_sequence(str(data_dir / "mocap_bvh" / "131_02.bvh"), str(data_dir / "meshes" / "makehuman"),
                           Scenario(seed=5), start=0, frames=16)
     arm = [KINECT_V1.index(f"{j}{s}") for j in ("Elbow", "Wrist") for s in ("Left", "Right")]
 

@@ -39,12 +39,12 @@ def test_unreadable_forest_leaves_the_tracker_without_parts(tmp_path):
     assert SkeletonTracker(settings=TrackerSettings(part_forest=str(bad))).forest is None
 
 
-def test_part_labels_from_skin_weights(shared_data):
+def test_part_labels_from_skin_weights(data_dir):
     from kinect_retarget.depth.depth_camera import DepthCamera
     from kinect_retarget.sim.body_part_labels import render_parts, surface_labels, vertex_parts
     from kinect_retarget.sim.depth_render import quad_sampler, surface_points
     from kinect_retarget.sim.makehuman_body import load_body
-    body = load_body(str(shared_data / "meshes" / "makehuman"))
+    body = load_body(str(data_dir / "meshes" / "makehuman"))
     labels = vertex_parts(body)
     counts = np.bincount(labels, minlength=len(PARTS))
     assert np.all(counts > 0)   # every part has skin

@@ -14,9 +14,9 @@ UP = np.array([0.0, 1.0, 0.0])   # the renders' gravity is straight down (no til
 
 
 @pytest.fixture(scope="module")
-def turned(shared_data):
+def turned(data_dir):
     from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence
-    return render_sequence(str(shared_data / "mocap_bvh" / "131_02.bvh"), str(shared_data / "meshes" / "makehuman"),
+    return render_sequence(str(data_dir / "mocap_bvh" / "131_02.bvh"), str(data_dir / "meshes" / "makehuman"),
                            Scenario(turn_deg=60.0, seed=8), start=0, frames=2)
 
 

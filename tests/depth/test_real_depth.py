@@ -18,8 +18,8 @@ def _plausible(pos, st):
     assert pos[J("ShoulderLeft"), 0] < pos[J("ShoulderRight"), 0]
 
 
-def test_skeltrack_frames(shared_data):
-    files = sorted((shared_data / "depth_real" / "skeltrack" / "tests" / "resources").glob("depth-data-*"))
+def test_skeltrack_frames(data_dir):
+    files = sorted((data_dir / "depth_real" / "skeltrack" / "tests" / "resources").glob("depth-data-*"))
     assert len(files) >= 10
     tr = SkeletonTracker()
     for i, f in enumerate(files):
@@ -29,10 +29,10 @@ def test_skeltrack_frames(shared_data):
         assert 0.7 < pos[J("Spine"), 2] < 1.6                                  # the person is 0.7-1.5 m away
 
 
-def test_fakenect_recording(shared_data):
+def test_fakenect_recording(data_dir):
     from kinect_retarget.device.disparity_calibration import Calibration
     from kinect_retarget.sim.depth_sequences import load_fakenect_dir
-    raws = load_fakenect_dir(shared_data / "depth_real" / "fakenect_openiss" / "fakenect-record")
+    raws = load_fakenect_dir(data_dir / "depth_real" / "fakenect_openiss" / "fakenect-record")
     cal = Calibration()
     tr = SkeletonTracker()
     found = 0

@@ -42,9 +42,9 @@ def test_connected_components_split_at_depth_steps():
     assert len(np.unique(connected_components(mask, z, max_jump=1.0)[mask])) == 2
 
 
-def test_rendered_person_is_found_among_furniture_and_a_bystander(shared_data, camera):
+def test_rendered_person_is_found_among_furniture_and_a_bystander(data_dir, camera):
     from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence
-    seq = render_sequence(str(shared_data / "mocap_bvh" / "131_02.bvh"), str(shared_data / "meshes" / "makehuman"),
+    seq = render_sequence(str(data_dir / "mocap_bvh" / "131_02.bvh"), str(data_dir / "meshes" / "makehuman"),
                           Scenario(second_person=(1.2, 3.5), boxes=[((-1.6, -0.9, 2.0), (-0.9, -0.1, 2.6))], seed=1),
                           frames=1)
     grid = DepthGrid.from_mm(seq.mm[0], camera)

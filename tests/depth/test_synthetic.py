@@ -17,10 +17,10 @@ def _unit(v):
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
-def test_direction_matching_retarget_follows_the_mocap(shared_data):
-    body = load_body(str(shared_data / "meshes" / "makehuman"))
+def test_direction_matching_retarget_follows_the_mocap(data_dir):
+    body = load_body(str(data_dir / "meshes" / "makehuman"))
     for clip, naming in (("131_03", "max"), ("01_01", "motionbuilder")):
-        names, _, pos, _ = read_bvh_positions(shared_data / "mocap_bvh" / f"{clip}.bvh")
+        names, _, pos, _ = read_bvh_positions(data_dir / "mocap_bvh" / f"{clip}.bvh")
         cmu = cmu_points(names, pos[:400:40])
         posed = pose_from_points(body, cmu)
         for a, b, ca, cb in (("ElbowLeft", "WristLeft", "elbow.L", "wrist.L"),

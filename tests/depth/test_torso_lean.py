@@ -25,9 +25,9 @@ def _trunk_errors(seq):
     return np.array(out)
 
 
-def test_trunk_lean_is_followed(shared_data, monkeypatch):
+def test_trunk_lean_is_followed(data_dir, monkeypatch):
     from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence
-    seq = render_sequence(str(shared_data / "mocap_bvh" / "131_03.bvh"), str(shared_data / "meshes" / "makehuman"),
+    seq = render_sequence(str(data_dir / "mocap_bvh" / "131_03.bvh"), str(data_dir / "meshes" / "makehuman"),
                           Scenario(seed=6), start=240, frames=30)
     leaning = _trunk_errors(seq)
     assert leaning.mean() < 8.0, leaning

@@ -1,4 +1,4 @@
-"""Fixtures for the device tests: real Kinect v1 depth frames from the shared data."""
+"""Fixtures for the device tests: real Kinect v1 depth frames from tests/data."""
 from __future__ import annotations
 
 import pytest
@@ -9,6 +9,6 @@ FAKENECT = "depth_real/fakenect_openiss/fakenect-record"
 
 
 @pytest.fixture(scope="session")
-def real_depth(shared_data):
+def real_depth(data_dir):
     """Ten consecutive real raw 11-bit depth frames (480, 640) uint16 recorded by libfreenect."""
-    return load_fakenect_dir(shared_data / FAKENECT, limit=10)
+    return load_fakenect_dir(data_dir / FAKENECT, limit=10)

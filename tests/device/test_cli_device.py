@@ -37,10 +37,10 @@ def _emulator_on_a_virtual_clock(monkeypatch, faults=None):
     monkeypatch.setattr(simulated_kinect, "EmulatedKinect", VirtualTimeKinect)
 
 
-def test_capture_simulated_with_dump_then_replay(tmp_path, shared_data, capsys, monkeypatch):
+def test_capture_simulated_with_dump_then_replay(tmp_path, data_dir, capsys, monkeypatch):
     _emulator_on_a_virtual_clock(monkeypatch)
     out, dump = tmp_path / "depth.npz", tmp_path / "packets.dump"
-    assert main(["capture", "--simulate", "--simulate-from", str(shared_data / FAKENECT), "--seconds", "0.5",
+    assert main(["capture", "--simulate", "--simulate-from", str(data_dir / FAKENECT), "--seconds", "0.5",
                  "--out", str(out), "--dump", str(dump)]) == 0
     live = np.load(out)
     assert live["raw"].shape[1:] == (480, 640) and live["raw"].shape[0] == 15    # 0.5 s of device time
@@ -89,13 +89,13 @@ def test_bad_input_exits_2_with_a_message_not_a_traceback(tmp_path, capsys):
     assert not list(tmp_path.glob("*.npz"))
 
 
-def test_truncated_dump_keeps_its_frames_and_exits_2(tmp_path, shared_data, capsys):
+def test_truncated_dump_keeps_its_frames_and_exits_2(tmp_path, data_dir, capsys):
     from kinect_retarget.device.dump import DumpWriter
     from kinect_retarget.sim.emulated_stream import packets_for_frames
     from kinect_retarget.sim.depth_sequences import load_fakenect_dir
     dump = tmp_path / "cut.dump"
     with DumpWriter(dump) as writer:
-        writer.write_packets(packets_for_frames(load_fakenect_dir(shared_data / FAKENECT, limit=3), 3))
+        writer.write_packets(packets_for_frames(load_fakenect_dir(data_dir / FAKENECT, limit=3), 3))
     dump.write_bytes(dump.read_bytes()[:-100])          # the last record loses its tail
     out = tmp_path / "cut.npz"
     assert main(["capture", "--replay", str(dump), "--out", str(out)]) == 2

@@ -12,8 +12,8 @@ IMAGE = (1280, 720)
 FOCAL = 1000.0
 
 
-def walking_take(shared_data, seconds: float = 6.0, name: str = "131_02.bvh") -> Take:
-    take = bvh.read(shared_data / "mocap_bvh" / name)
+def walking_take(data_dir, seconds: float = 6.0, name: str = "131_02.bvh") -> Take:
+    take = bvh.read(data_dir / "mocap_bvh" / name)
     step = int(round(take.rate / 30.0))
     frames = np.arange(0, take.frame_count, step)
     return take.slice(frames[take.times[frames] <= seconds])

@@ -18,8 +18,8 @@ EXACT = dict(smooth_2d_s=0.0, smooth_depth_s=0.0, noise_aware=False)
 
 
 @pytest.fixture(scope="module")
-def walk(shared_data):
-    return walking_take(shared_data, 6.0)
+def walk(data_dir):
+    return walking_take(data_dir, 6.0)
 
 
 @pytest.mark.parametrize("azimuth", [0.0, 70.0, 200.0])

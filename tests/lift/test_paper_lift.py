@@ -12,8 +12,8 @@ from .mocap import IMAGE, rigid, seen_from, true_signs, walking_take
 
 
 @pytest.fixture(scope="module")
-def walk(shared_data):
-    return walking_take(shared_data, 4.0)
+def walk(data_dir):
+    return walking_take(data_dir, 4.0)
 
 
 def _ortho_tracks(truth, s=220.0):

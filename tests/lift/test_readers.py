@@ -24,8 +24,8 @@ COCO_FROM_V1 = {"nose": "Head", **{f"{s.lower()}_{p.lower()}": f"{p}{s}" for s i
 
 
 @pytest.fixture(scope="module")
-def projected(shared_data):
-    truth = seen_from(walking_take(shared_data, 2.0), 20.0)
+def projected(data_dir):
+    truth = seen_from(walking_take(data_dir, 2.0), 20.0)
     return truth, camera().project(truth.positions)
 
 
@@ -154,14 +154,14 @@ def test_coco_results_list_and_malformed(tmp_path, projected):
         read_2d(tmp_path / "other.json", "coco")
 
 
-def test_cli_lift_with_calibration_take(tmp_path, projected, shared_data):
+def test_cli_lift_with_calibration_take(tmp_path, projected, data_dir):
     from kinect_retarget.cli import main
     from kinect_retarget.lift.bones import lengths_from_take
     from kinect_retarget.takes import load_take
     truth, uv = projected
     (tmp_path / "kp").mkdir()
     folder = openpose_folder(tmp_path / "kp", uv)
-    calib = shared_data / "mocap_bvh" / "131_02.bvh"
+    calib = data_dir / "mocap_bvh" / "131_02.bvh"
     out = tmp_path / "lifted.krtake"
     assert main(["lift", str(folder), "--out", str(out), "--calibrate", str(calib), "--focal", "1000",
                  "--image-size", "1280", "720"]) == 0

@@ -21,8 +21,8 @@ NAMES = ("HipCenter", "ShoulderCenter", "Head", "ElbowLeft", "WristLeft", "Elbow
 
 
 @pytest.fixture(scope="module")
-def sequence(shared_data):
-    take = walking_take(shared_data, 7.0).slice(slice(150, 180))  # one second in mid-walk
+def sequence(data_dir):
+    take = walking_take(data_dir, 7.0).slice(slice(150, 180))  # one second in mid-walk
     pos = view_points(take.positions, 80.0, 5.0, 3.5, take.positions[:, 0].mean(axis=0))  # walks across
     cam = Camera.for_image(*SIZE, 300.0)
     rng = np.random.default_rng(11)

@@ -1,4 +1,4 @@
-"""Live test helpers: small real takes from the shared Kinect v2 recordings, and a stand-in pipeline for
+"""Live test helpers: small real takes from the Kinect v2 recordings in tests/data, and a stand-in pipeline for
 tests of the pump plumbing (the retarget itself is tested against the real engine elsewhere)."""
 from __future__ import annotations
 
@@ -21,8 +21,8 @@ def read_kinectreader_csv(path, frames: int | None = None) -> Take:
 
 
 @pytest.fixture
-def wave_take(shared_data) -> Take:
-    return read_kinectreader_csv(shared_data / "kinect_v2" / "Ges01_wavehand.csv")
+def wave_take(data_dir) -> Take:
+    return read_kinectreader_csv(data_dir / "kinect_v2" / "Ges01_wavehand.csv")
 
 
 @pytest.fixture

@@ -41,8 +41,8 @@ def test_users_are_assembled_apart():
     assert [d[0] for d in zero_based.flush()] == [0]
 
 
-def test_fanout_routes_each_body_to_its_queue(shared_data, tmp_path):
-    path = write_two_person_ntu(shared_data, tmp_path / "S001C001P001R001A050.skeleton")
+def test_fanout_routes_each_body_to_its_queue(data_dir, tmp_path):
+    path = write_two_person_ntu(data_dir, tmp_path / "S001C001P001R001A050.skeleton")
     src = TakePlayback(str(path), speed=5.0, bodies=(0, 1))
     fan = BodyFanout(src)
     a, b = fan.body(0), fan.body(1)
@@ -66,8 +66,8 @@ def test_fanout_routes_each_body_to_its_queue(shared_data, tmp_path):
     assert src.stopping
 
 
-def test_fanout_counts_frames_nobody_follows(shared_data, tmp_path):
-    path = write_two_person_ntu(shared_data, tmp_path / "S001C001P001R001A050.skeleton")
+def test_fanout_counts_frames_nobody_follows(data_dir, tmp_path):
+    path = write_two_person_ntu(data_dir, tmp_path / "S001C001P001R001A050.skeleton")
     src = TakePlayback(str(path), speed=50.0, bodies=(0, 1))
     fan = BodyFanout(src)
     q = FrameQueue()

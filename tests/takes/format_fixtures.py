@@ -89,12 +89,12 @@ def write_utkinect(take: Take, path: Path, first_frame: int = 248) -> None:
     path.write_text(_lines(rows, " ".join(["%d"] + ["%.6g"] * (3 * nj))))
 
 
-def make_all(shared_data: Path, out: Path = FIXTURES) -> dict[str, Path]:
+def make_all(data_dir: Path, out: Path = FIXTURES) -> dict[str, Path]:
     """The committed fixtures: small, converted from real Kinect v2 recordings."""
     from kinect_retarget.takes import kinect_v2_csv
     out.mkdir(exist_ok=True)
-    ges = kinect_v2_csv.read(shared_data / "kinect_v2" / "Ges01_wavehand.csv").slice(slice(0, 40))
-    joints = kinect_v2_csv.read(shared_data / "kinect_v2" / "joints.csv").slice(slice(0, 60))
+    ges = kinect_v2_csv.read(data_dir / "kinect_v2" / "Ges01_wavehand.csv").slice(slice(0, 40))
+    joints = kinect_v2_csv.read(data_dir / "kinect_v2" / "joints.csv").slice(slice(0, 60))
     # Give the NTU file frames with no body: blank out the first three frames.
     ges.states[:3] = NOT_TRACKED
     ges.positions[:3] = np.nan

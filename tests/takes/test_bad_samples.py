@@ -70,8 +70,8 @@ def test_line_formats_drop_bad_joint_samples(tmp_path, fmt, bad):
     assert take.metadata["warnings"][-1].startswith(f"{path}:{first + 31}: ")
 
 
-def test_kinect_v2_csv_drops_bad_samples(shared_data, tmp_path):
-    src = shared_data / "kinect_v2" / "Ges04_comehere.csv"
+def test_kinect_v2_csv_drops_bad_samples(data_dir, tmp_path):
+    src = data_dir / "kinect_v2" / "Ges04_comehere.csv"
     lines = src.read_text().splitlines(keepends=True)
     lines[7] = _set_fields(lines[7], ",", {1 + 4 * 5 + 1: "NaN"})         # ElbowLeft y, line 8
     lines[90] = _set_fields(lines[90], ",", {1 + 4 * 11 + 2: "1e300"})    # HandRight z, absurdly far
@@ -105,8 +105,8 @@ def test_kinectron_names_the_record(tmp_path):
     _check(load_take(path), clean, [(11, 3), (12, 4), (13, 5)], 11, label="record")
 
 
-def test_uiprmd_drops_joints_below_a_broken_angle(shared_data, tmp_path):
-    folder = shared_data / "kinect_v2_vicon_uiprmd" / "Kinect"
+def test_uiprmd_drops_joints_below_a_broken_angle(data_dir, tmp_path):
+    folder = data_dir / "kinect_v2_vicon_uiprmd" / "Kinect"
     shutil.copy(folder / "m01_s01_e01_positions.txt", tmp_path / "m01_s01_e01_positions.txt")
     lines = (folder / "m01_s01_e01_angles.txt").read_text().splitlines(keepends=True)
     lines[12] = _set_fields(lines[12], ",", {3 * 8: "nan"})  # LeftForearm's angle: the wrist below it is lost
@@ -118,14 +118,14 @@ def test_uiprmd_drops_joints_below_a_broken_angle(shared_data, tmp_path):
     assert take.metadata["dropped_joint_samples"] == 1 and take.metadata["first_dropped_line"] == 13
 
 
-def test_bvh_drops_joints_below_a_broken_channel(shared_data, tmp_path):
-    lines = (shared_data / "mocap_bvh" / "131_03.bvh").read_text().splitlines(keepends=True)
+def test_bvh_drops_joints_below_a_broken_channel(data_dir, tmp_path):
+    lines = (data_dir / "mocap_bvh" / "131_03.bvh").read_text().splitlines(keepends=True)
     tokens = lines[400].split()
     tokens[5] = "nan"  # the root's third rotation: every joint of that frame but the root itself
     lines[400] = " ".join(tokens) + "\n"
     (tmp_path / "nan.bvh").write_text("".join(lines))
     take = load_take(tmp_path / "nan.bvh")
-    clean = load_take(shared_data / "mocap_bvh" / "131_03.bvh")
+    clean = load_take(data_dir / "mocap_bvh" / "131_03.bvh")
     frame = int(np.argmax(take.states.min(axis=1) != clean.states.min(axis=1)))
     assert take.metadata["first_dropped_line"] == 401
     assert take.states[frame].tolist() == [2] + [NOT_TRACKED] * 19  # HipCenter is the root's own position

@@ -13,12 +13,12 @@ from tests.takes.two_performers import performers, write_two_person_ntu
 
 
 @pytest.fixture
-def two_ntu(shared_data, tmp_path):
-    return write_two_person_ntu(shared_data, tmp_path / "S001C001P001R001A050.skeleton")
+def two_ntu(data_dir, tmp_path):
+    return write_two_person_ntu(data_dir, tmp_path / "S001C001P001R001A050.skeleton")
 
 
-def test_ntu_bodies_read_as_their_own_performers(two_ntu, shared_data):
-    first, second = performers(shared_data)
+def test_ntu_bodies_read_as_their_own_performers(two_ntu, data_dir):
+    first, second = performers(data_dir)
     a, b = load_take(two_ntu), load_take(two_ntu, body=1)
     assert body_count(a) == body_count(b) == 2 and b.metadata["body"] == 1 and "body" not in a.metadata
     np.testing.assert_allclose(a.positions, first.positions, atol=5e-6)
@@ -30,7 +30,7 @@ def test_ntu_bodies_read_as_their_own_performers(two_ntu, shared_data):
         load_take(two_ntu, body=2)
 
 
-def test_ntu_frames_without_the_second_body_are_untracked(shared_data, tmp_path):
+def test_ntu_frames_without_the_second_body_are_untracked(data_dir, tmp_path):
     from tests.takes import format_fixtures as fx
     path = fx.FIXTURES / "S001C001P001R001A001_converted_Ges01.skeleton"  # a second body in frames 10-19
     b = load_take(path, body=1)
@@ -38,8 +38,8 @@ def test_ntu_frames_without_the_second_body_are_untracked(shared_data, tmp_path)
     np.testing.assert_allclose(b.positions[10:20], load_take(path).positions[10:20] + [1.0, 0, 0], atol=5e-6)
 
 
-def test_single_body_formats_refuse_other_bodies(shared_data):
-    path = shared_data / "kinect_v2" / "Ges01_wavehand.csv"
+def test_single_body_formats_refuse_other_bodies(data_dir):
+    path = data_dir / "kinect_v2" / "Ges01_wavehand.csv"
     assert body_count(load_take(path)) == 1
     with pytest.raises(TakeError, match="hold one body"):
         load_take(path, body=1)
@@ -47,8 +47,8 @@ def test_single_body_formats_refuse_other_bodies(shared_data):
         load_take(path, body=-1)
 
 
-def test_kinectron_two_performers(shared_data, tmp_path):
-    raw = json.loads((shared_data / "kinect_v2" / "recorded_skeleton.json").read_text())[:30]
+def test_kinectron_two_performers(data_dir, tmp_path):
+    raw = json.loads((data_dir / "kinect_v2" / "recorded_skeleton.json").read_text())[:30]
     out = []
     for rec in raw:  # a second performer, 1 m along X, tracked from the 10th record on, listed first
         out.append(rec)

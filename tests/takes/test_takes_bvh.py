@@ -18,8 +18,8 @@ CMU_UNIT = 0.0254 / 0.45
 
 
 @pytest.fixture(scope="module")
-def jump(shared_data):
-    return bvh.read_bvh_skeleton(shared_data / "mocap_bvh" / "01_01.bvh")
+def jump(data_dir):
+    return bvh.read_bvh_skeleton(data_dir / "mocap_bvh" / "01_01.bvh")
 
 
 def _raw_motion_line(path, frame):
@@ -29,9 +29,9 @@ def _raw_motion_line(path, frame):
 
 
 @pytest.mark.parametrize("name", sorted(CMU))
-def test_cmu_files_read_as_kinect_v1_takes(shared_data, name):
+def test_cmu_files_read_as_kinect_v1_takes(data_dir, name):
     frames, duration, family = CMU[name]
-    take = bvh.read(shared_data / "mocap_bvh" / name)
+    take = bvh.read(data_dir / "mocap_bvh" / name)
     assert take.skeleton is KINECT_V1
     assert take.source_format == "bvh"
     assert take.frame_count == frames
@@ -48,8 +48,8 @@ def test_cmu_files_read_as_kinect_v1_takes(shared_data, name):
         == pytest.approx(0.85, abs=0.12)
 
 
-def test_root_position_matches_raw_text(shared_data, jump):
-    path = shared_data / "mocap_bvh" / "01_01.bvh"
+def test_root_position_matches_raw_text(data_dir, jump):
+    path = data_dir / "mocap_bvh" / "01_01.bvh"
     for frame in (0, 1000, 2751):
         raw = _raw_motion_line(path, frame)
         np.testing.assert_allclose(jump.values[frame], raw)
@@ -102,8 +102,8 @@ def test_bone_lengths_are_preserved_every_frame(jump):
                                                           lengths.shape), atol=1e-9)
 
 
-def test_frame0_tpose_faces_the_virtual_kinect(shared_data):
-    take = bvh.read(shared_data / "mocap_bvh" / "01_01.bvh", min_range=None)
+def test_frame0_tpose_faces_the_virtual_kinect(data_dir):
+    take = bvh.read(data_dir / "mocap_bvh" / "01_01.bvh", min_range=None)
     p = take.positions[0]
     k = KINECT_V1.index
     # Performer's left hand is on the sensor's right: Kinect -X. Arms out level with the shoulders.
@@ -118,15 +118,15 @@ def test_frame0_tpose_faces_the_virtual_kinect(shared_data):
     assert take.positions[..., 2].min() < 0
 
 
-def test_makehuman_pose_decimetres_z_up(shared_data):
+def test_makehuman_pose_decimetres_z_up(data_dir):
     for name in ("tpose.bvh", "benchmark.bvh"):
-        motion = bvh.read_bvh_skeleton(shared_data / "meshes" / "makehuman" / name)
+        motion = bvh.read_bvh_skeleton(data_dir / "meshes" / "makehuman" / name)
         assert motion.family == "makehuman"
         assert motion.units_to_metres == 0.1
         assert (motion.up_axis, motion.up_sign) == (2, 1.0)
         assert motion.frame_count == 1
     assert len(motion.skeleton.names) >= 163
-    take = bvh.read(shared_data / "meshes" / "makehuman" / "tpose.bvh")
+    take = bvh.read(data_dir / "meshes" / "makehuman" / "tpose.bvh")
     k = KINECT_V1.index
     p = take.positions[0]
     assert p[k("Head"), 1] - p[k("AnkleLeft"), 1] == pytest.approx(1.5, abs=0.12)
@@ -134,10 +134,10 @@ def test_makehuman_pose_decimetres_z_up(shared_data):
     assert take.rate == 24.0
 
 
-def test_explicit_scale_and_unit_heuristic(shared_data, tmp_path):
-    src = (shared_data / "mocap_bvh" / "131_01.bvh").read_text()
-    take = bvh.read(shared_data / "mocap_bvh" / "131_01.bvh", scale=0.05, min_range=None)
-    ref = bvh.read(shared_data / "mocap_bvh" / "131_01.bvh", min_range=None)
+def test_explicit_scale_and_unit_heuristic(data_dir, tmp_path):
+    src = (data_dir / "mocap_bvh" / "131_01.bvh").read_text()
+    take = bvh.read(data_dir / "mocap_bvh" / "131_01.bvh", scale=0.05, min_range=None)
+    ref = bvh.read(data_dir / "mocap_bvh" / "131_01.bvh", min_range=None)
     k = KINECT_V1.index
     spine = lambda t: np.linalg.norm(t.positions[:, k("Head")] - t.positions[:, k("HipCenter")], axis=-1)
     np.testing.assert_allclose(spine(take), spine(ref) * 0.05 / CMU_UNIT)
@@ -160,18 +160,18 @@ def test_explicit_scale_and_unit_heuristic(shared_data, tmp_path):
     with pytest.raises(TakeError, match=r"snake\.bvh: BVH skeleton not recognised as a humanoid: no node where"):
         bvh.read(tmp_path / "snake.bvh")
     with pytest.raises(TakeError, match="scale must be a positive"):
-        bvh.read(shared_data / "mocap_bvh" / "131_01.bvh", scale=-1.0)
+        bvh.read(data_dir / "mocap_bvh" / "131_01.bvh", scale=-1.0)
 
 
-def test_looks_like(shared_data):
-    head = (shared_data / "mocap_bvh" / "131_02.bvh").read_bytes()[:4096]
+def test_looks_like(data_dir):
+    head = (data_dir / "mocap_bvh" / "131_02.bvh").read_bytes()[:4096]
     assert bvh.looks_like(head)
     assert bvh.looks_like(b"\xef\xbb\xbfHIERARCHY\r\nROOT Hips")
-    assert not bvh.looks_like((shared_data / "kinect_v2" / "joints.csv").read_bytes()[:4096])
+    assert not bvh.looks_like((data_dir / "kinect_v2" / "joints.csv").read_bytes()[:4096])
 
 
-def _corrupt(tmp_path, shared_data, name, edit):
-    lines = (shared_data / "mocap_bvh" / "131_03.bvh").read_text().splitlines(keepends=True)
+def _corrupt(tmp_path, data_dir, name, edit):
+    lines = (data_dir / "mocap_bvh" / "131_03.bvh").read_text().splitlines(keepends=True)
     path = tmp_path / name
     path.write_text("".join(edit(lines)))
     return path
@@ -200,9 +200,9 @@ CORRUPTIONS = {
 
 
 @pytest.mark.parametrize("name", sorted(CORRUPTIONS))
-def test_corrupt_files_name_file_and_line(tmp_path, shared_data, name):
+def test_corrupt_files_name_file_and_line(tmp_path, data_dir, name):
     edit, pattern = CORRUPTIONS[name]
-    path = _corrupt(tmp_path, shared_data, name, edit)
+    path = _corrupt(tmp_path, data_dir, name, edit)
     with pytest.raises(TakeError, match=pattern):
         bvh.read(path)
 
@@ -244,13 +244,13 @@ SAME_DEFINITION = ("HipCenter", "ShoulderCenter", "ShoulderLeft", "ElbowLeft", "
 
 
 @pytest.mark.parametrize("family", sorted(RENAMES))
-def test_other_rig_families_by_renaming_real_mocap(shared_data, tmp_path, family):
+def test_other_rig_families_by_renaming_real_mocap(data_dir, tmp_path, family):
     import re
     table = {}
     for src, dst in RENAMES[family].items():
         for side, s, l, d in (("Left", "L", "L", "l"), ("Right", "R", "R", "r")):
             table[src.format(L=side, s=s)] = dst.format(L=side, s=s, l=l, d=d)
-    lines = (shared_data / "mocap_bvh" / "01_01.bvh").read_text().splitlines()
+    lines = (data_dir / "mocap_bvh" / "01_01.bvh").read_text().splitlines()
     first = next(i for i, line in enumerate(lines) if line.startswith("Frame Time")) + 1
     frames = 240  # enough motion; keeps the test fast
     text = "\n".join(line if not line.startswith("Frames:") else f"Frames: {frames}"
@@ -268,9 +268,9 @@ def test_other_rig_families_by_renaming_real_mocap(shared_data, tmp_path, family
     np.testing.assert_allclose(take.positions[:, idx], ref.positions[:, idx], atol=1e-9)
 
 
-def test_virtual_kinect_reproduces_the_take(jump, shared_data):
+def test_virtual_kinect_reproduces_the_take(jump, data_dir):
     """Other code projects any BVH joint with the same sensor as the take (e.g. fingertips to 2D)."""
-    take = bvh.read(shared_data / "mocap_bvh" / "01_01.bvh")
+    take = bvh.read(data_dir / "mocap_bvh" / "01_01.bvh")
     cam = bvh.virtual_kinect(jump)
     np.testing.assert_allclose(cam.to_kinect(bvh.kinect_joints_lab(jump)), take.positions, atol=1e-12)
     assert cam.as_dict()["distance_m"] == pytest.approx(take.metadata["virtual_camera"]["distance_m"])

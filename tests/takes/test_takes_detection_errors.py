@@ -9,7 +9,7 @@ from kinect_retarget.core.take import TakeError
 from kinect_retarget.takes import READERS, detect_format, load_take
 from tests.takes import format_fixtures as fx
 
-REAL = {  # path under shared data: expected format
+REAL = {  # path under tests/data: expected format
     **{f"kinect_v2/{n}": "kinect_v2_csv" for n in (
         "Ges01_wavehand.csv", "Ges02_balancinghands.csv", "Ges03_drawlines.csv", "Ges04_comehere.csv",
         "Ges05_demopoint.csv", "Ges06_chickenwing.csv", "joints.csv")},
@@ -22,8 +22,8 @@ FIXTURE_FORMATS = {"ntu": "ntu_skeleton", "msrc12": "msrc12", "utkinect": "utkin
 
 
 @pytest.mark.parametrize("rel", sorted(REAL))
-def test_detects_real_files(shared_data, rel):
-    assert detect_format(shared_data / rel) == REAL[rel]
+def test_detects_real_files(data_dir, rel):
+    assert detect_format(data_dir / rel) == REAL[rel]
 
 
 @pytest.mark.parametrize("name", sorted(FIXTURE_FORMATS))
@@ -34,14 +34,14 @@ def test_detects_converted_fixtures(name):
     assert load_take(fx.FIXTURES / path).frame_count > 30
 
 
-def test_detection_ignores_extension(shared_data, tmp_path):
-    (tmp_path / "take.txt").write_bytes((shared_data / "mocap_bvh" / "131_01.bvh").read_bytes())
-    (tmp_path / "take.bvh").write_bytes((shared_data / "kinect_v2" / "Ges02_balancinghands.csv").read_bytes())
+def test_detection_ignores_extension(data_dir, tmp_path):
+    (tmp_path / "take.txt").write_bytes((data_dir / "mocap_bvh" / "131_01.bvh").read_bytes())
+    (tmp_path / "take.bvh").write_bytes((data_dir / "kinect_v2" / "Ges02_balancinghands.csv").read_bytes())
     assert detect_format(tmp_path / "take.txt") == "bvh"
     assert detect_format(tmp_path / "take.bvh") == "kinect_v2_csv"
 
 
-def test_unknown_and_empty(tmp_path, shared_data):
+def test_unknown_and_empty(tmp_path, data_dir):
     (tmp_path / "notes.csv").write_text("name,value\nfoo,1\n")
     with pytest.raises(TakeError, match=r"notes\.csv: unknown take format \(supported: "):
         load_take(tmp_path / "notes.csv")
@@ -57,17 +57,17 @@ def test_unknown_and_empty(tmp_path, shared_data):
 # --- corrupted copies: each line-based format, each corruption, the exact line named ---------------------
 
 LINE_FORMATS = {  # format: (source file, index of a data line to damage, field separator)
-    "kinect_v2_csv": ("shared:kinect_v2/Ges01_wavehand.csv", 40, ","),
-    "bvh": ("shared:mocap_bvh/131_02.bvh", 300, " "),
+    "kinect_v2_csv": ("data:kinect_v2/Ges01_wavehand.csv", 40, ","),
+    "bvh": ("data:mocap_bvh/131_02.bvh", 300, " "),
     "msrc12": ("fixture:P1_1_1_converted_joints.csv", 20, " "),
     "utkinect": ("fixture:joints_s01_e01_converted_joints.txt", 20, " "),
     "ntu_skeleton": ("fixture:S001C001P001R001A001_converted_Ges01.skeleton", 210, " "),  # a joint line
 }
 
 
-def _source(shared_data, spec):
+def _source(data_dir, spec):
     kind, rel = spec.split(":", 1)
-    return (shared_data / rel) if kind == "shared" else fx.FIXTURES / rel
+    return (data_dir / rel) if kind == "data" else fx.FIXTURES / rel
 
 
 def _damage(lines, i, sep, how):
@@ -92,9 +92,9 @@ EXPECTED = {  # structural damage keeps its clear error (a NaN joint value does 
 
 @pytest.mark.parametrize("how", sorted(EXPECTED))
 @pytest.mark.parametrize("fmt", sorted(LINE_FORMATS))
-def test_corrupted_line_formats(shared_data, tmp_path, fmt, how):
+def test_corrupted_line_formats(data_dir, tmp_path, fmt, how):
     spec, i, sep = LINE_FORMATS[fmt]
-    src = _source(shared_data, spec)
+    src = _source(data_dir, spec)
     lines = src.read_text().splitlines(keepends=True)
     name = f"bad_{how}{src.suffix}"
     (tmp_path / name).write_text("".join(_damage(lines, i, sep, how)))
@@ -113,8 +113,8 @@ def test_empty_copy(tmp_path, fmt):
         import_module(f"kinect_retarget.takes.{fmt}").read(path)
 
 
-def test_no_tracked_frame(shared_data, tmp_path):
-    lines = (shared_data / "kinect_v2" / "joints.csv").read_text().splitlines()
+def test_no_tracked_frame(data_dir, tmp_path):
+    lines = (data_dir / "kinect_v2" / "joints.csv").read_text().splitlines()
     dead = []
     for line in lines[:10]:
         fields = line.rstrip(",").split(",")
@@ -133,8 +133,8 @@ def test_no_tracked_frame(shared_data, tmp_path):
         load_take(tmp_path / "time.csv")
 
 
-def test_corrupted_kinectron(shared_data, tmp_path):
-    text = (shared_data / "kinect_v2" / "recorded_skeleton.json").read_text()
+def test_corrupted_kinectron(data_dir, tmp_path):
+    text = (data_dir / "kinect_v2" / "recorded_skeleton.json").read_text()
     (tmp_path / "cut.json").write_text(text[: len(text) // 2])
     with pytest.raises(TakeError, match=r"cut\.json:1: invalid JSON at column \d+"):
         load_take(tmp_path / "cut.json")
@@ -163,11 +163,11 @@ def test_readers_registered():
             "utkinect", "uiprmd"} <= set(READERS)
 
 
-def test_nothing_tracked_in_converted_formats(tmp_path, shared_data):
+def test_nothing_tracked_in_converted_formats(tmp_path, data_dir):
     """A file whose every frame is empty is an error, not an empty take, in every Kinect format."""
     from kinect_retarget.core.skeletons import NOT_TRACKED
     from kinect_retarget.takes import kinect_v2_csv
-    take = kinect_v2_csv.read(shared_data / "kinect_v2" / "Ges03_drawlines.csv").slice(slice(0, 12))
+    take = kinect_v2_csv.read(data_dir / "kinect_v2" / "Ges03_drawlines.csv").slice(slice(0, 12))
     take.states[:] = NOT_TRACKED
     fx.write_ntu(take, tmp_path / "none.skeleton")
     fx.write_msrc12(fx.v1_from_v2(take), tmp_path / "none_msrc.csv")
@@ -194,7 +194,7 @@ def test_empty_json_and_uiprmd(tmp_path):
 
 @pytest.mark.parametrize("rel", sorted(REAL) + ["uiprmd:m05_s01_e01_angles.txt", "fixture:ntu", "fixture:msrc12",
                                                 "fixture:utkinect"])
-def test_every_reader_take_saves_as_krtake(shared_data, tmp_path, rel):
+def test_every_reader_take_saves_as_krtake(data_dir, tmp_path, rel):
     """Whatever was read can be saved in the project's format and read back unchanged (metadata too)."""
     import numpy as np
     from kinect_retarget.core.skeletons import NOT_TRACKED
@@ -204,9 +204,9 @@ def test_every_reader_take_saves_as_krtake(shared_data, tmp_path, rel):
                               "msrc12": "P1_1_1_converted_joints.csv",
                               "utkinect": "joints_s01_e01_converted_joints.txt"}[rel[8:]]
     elif rel.startswith("uiprmd:"):
-        path = shared_data / "kinect_v2_vicon_uiprmd" / "Kinect" / rel[7:]
+        path = data_dir / "kinect_v2_vicon_uiprmd" / "Kinect" / rel[7:]
     else:
-        path = shared_data / rel
+        path = data_dir / rel
     take = load_take(path)
     krtake.write(tmp_path / "saved.krtake", take)
     back = krtake.read(tmp_path / "saved.krtake")

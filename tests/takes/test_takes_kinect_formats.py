@@ -21,8 +21,8 @@ V2_CSV = {  # file: (frames, duration s) from data/README.md
 
 
 @pytest.mark.parametrize("name", sorted(V2_CSV))
-def test_kinect_v2_csv_real_files(shared_data, name, rng):
-    path = shared_data / "kinect_v2" / name
+def test_kinect_v2_csv_real_files(data_dir, name, rng):
+    path = data_dir / "kinect_v2" / name
     frames, duration = V2_CSV[name]
     take = kinect_v2_csv.read(path)
     assert take.skeleton is KINECT_V2 and take.source_format == "kinect_v2_csv"
@@ -41,16 +41,16 @@ def test_kinect_v2_csv_real_files(shared_data, name, rng):
         assert take.times[i] == pytest.approx((int(fields[0]) - t0) / 1e7)
 
 
-def test_kinect_v2_csv_first_line_of_joints(shared_data):
-    take = kinect_v2_csv.read(shared_data / "kinect_v2" / "joints.csv")
+def test_kinect_v2_csv_first_line_of_joints(data_dir):
+    take = kinect_v2_csv.read(data_dir / "kinect_v2" / "joints.csv")
     np.testing.assert_allclose(take.positions[0, 0], [0.0710328, -0.600598, 0.978207])
     np.testing.assert_allclose(take.positions[0, 1], [0.0733363, -0.285628, 0.946217])
     assert take.states[0, 0] == INFERRED and take.states[0, 1] == TRACKED
     assert take.metadata["first_timestamp"] == 31867373716 and take.metadata["time_unit"] == "100 ns ticks"
 
 
-def test_kinectron_json_real_file(shared_data):
-    path = shared_data / "kinect_v2" / "recorded_skeleton.json"
+def test_kinectron_json_real_file(data_dir):
+    path = data_dir / "kinect_v2" / "recorded_skeleton.json"
     take, two_d = kinectron_json.read_with_2d(path)
     assert take.skeleton is KINECT_V2 and take.source_format == "kinectron_json"
     assert take.frame_count == 286
@@ -82,8 +82,8 @@ def test_kinectron_json_real_file(shared_data):
     assert two_d["left_hand_state"].shape == (286,)
 
 
-def test_kinectron_untracked_and_duplicate_bodies(tmp_path, shared_data):
-    raw = json.loads((shared_data / "kinect_v2" / "recorded_skeleton.json").read_text())[:20]
+def test_kinectron_untracked_and_duplicate_bodies(tmp_path, data_dir):
+    raw = json.loads((data_dir / "kinect_v2" / "recorded_skeleton.json").read_text())[:20]
     raw[3] = {**raw[3], "tracked": False, "joints": []}
     other = {**raw[5], "trackingId": "999", "bodyIndex": 1}
     other["joints"] = [{**j, "cameraX": j["cameraX"] + 1.0} for j in raw[5]["joints"]]
@@ -96,18 +96,18 @@ def test_kinectron_untracked_and_duplicate_bodies(tmp_path, shared_data):
 
 
 @pytest.fixture(scope="module")
-def fixtures(shared_data, tmp_path_factory):
+def fixtures(data_dir, tmp_path_factory):
     """The committed converted fixtures, checked to be exactly what the converters make today."""
-    fresh = fx.make_all(shared_data, tmp_path_factory.mktemp("fixtures"))
+    fresh = fx.make_all(data_dir, tmp_path_factory.mktemp("fixtures"))
     for name, path in fresh.items():
         committed = fx.FIXTURES / path.name
         assert committed.read_bytes() == path.read_bytes(), f"{committed} is stale: regenerate it"
     return {name: fx.FIXTURES / path.name for name, path in fresh.items()}
 
 
-def test_ntu_fixture(fixtures, shared_data):
+def test_ntu_fixture(fixtures, data_dir):
     take, two_d = ntu_skeleton.read_with_2d(fixtures["ntu"])
-    src = kinect_v2_csv.read(shared_data / "kinect_v2" / "Ges01_wavehand.csv").slice(slice(0, 40))
+    src = kinect_v2_csv.read(data_dir / "kinect_v2" / "Ges01_wavehand.csv").slice(slice(0, 40))
     assert take.skeleton is KINECT_V2 and take.rate == 30.0 and take.frame_count == 40
     assert np.all(take.states[:3] == NOT_TRACKED) and take.metadata["frames_without_body"] == 3
     assert take.metadata["max_bodies"] == 2
@@ -121,9 +121,9 @@ def test_ntu_fixture(fixtures, shared_data):
     assert np.all(two_d["body_count"][:3] == 0) and np.all(two_d["body_count"][10:20] == 2)
 
 
-def test_msrc12_fixture(fixtures, shared_data):
+def test_msrc12_fixture(fixtures, data_dir):
     take = msrc12.read(fixtures["msrc12"])
-    src = fx.v1_from_v2(kinect_v2_csv.read(shared_data / "kinect_v2" / "joints.csv").slice(slice(0, 60)))
+    src = fx.v1_from_v2(kinect_v2_csv.read(data_dir / "kinect_v2" / "joints.csv").slice(slice(0, 60)))
     assert take.skeleton is KINECT_V1 and take.frame_count == 60 and take.rate == 30.0
     assert take.metadata["first_timestamp"] == pytest.approx(0.033333) and take.metadata["time_unit"] == "s"
     tracked = src.states != NOT_TRACKED
@@ -132,11 +132,11 @@ def test_msrc12_fixture(fixtures, shared_data):
     np.testing.assert_allclose(take.times, src.times, atol=2e-6)
 
 
-def test_utkinect_fixture(fixtures, shared_data):
+def test_utkinect_fixture(fixtures, data_dir):
     take = utkinect.read(fixtures["utkinect"])
     keep = np.ones(60, dtype=bool)
     keep[[7, 8, 30]] = False
-    src = fx.v1_from_v2(kinect_v2_csv.read(shared_data / "kinect_v2" / "joints.csv").slice(slice(0, 60)))
+    src = fx.v1_from_v2(kinect_v2_csv.read(data_dir / "kinect_v2" / "joints.csv").slice(slice(0, 60)))
     assert take.skeleton is KINECT_V1 and take.frame_count == 57 and take.rate == 30.0
     np.testing.assert_allclose(take.positions, src.positions[keep], atol=5e-6)
     # Frame numbers keep the gaps: frame 7 follows frame 6 after 3 video frames (0.1 s).

@@ -27,9 +27,9 @@ def tool():
 
 
 @pytest.fixture(scope="module")
-def sources(tool, shared_data):
-    """The takes the tool converts, read straight from the shared data."""
-    return {**tool.kinect_v2_takes(shared_data), **tool.cmu_takes(shared_data)}
+def sources(tool, data_dir):
+    """The takes the tool converts, read straight from the repository's tests/data."""
+    return {**tool.kinect_v2_takes(data_dir), **tool.cmu_takes(data_dir)}
 
 
 def test_every_sample_is_listed_and_credited(tool):

@@ -14,8 +14,8 @@ FRAMES = {"m01": 73, "m05": 80, "m07": 63}  # deep squat, sit-to-stand, shoulder
 
 
 @pytest.mark.parametrize("move", sorted(FRAMES))
-def test_real_movements(shared_data, move):
-    folder = shared_data / "kinect_v2_vicon_uiprmd" / "Kinect"
+def test_real_movements(data_dir, move):
+    folder = data_dir / "kinect_v2_vicon_uiprmd" / "Kinect"
     pos_file, ang_file = folder / f"{move}_s01_e01_positions.txt", folder / f"{move}_s01_e01_angles.txt"
     assert detect_format(pos_file) == "uiprmd" and detect_format(ang_file) == "uiprmd"
     take = load_take(pos_file)
@@ -41,15 +41,15 @@ def test_real_movements(shared_data, move):
     np.testing.assert_allclose(thigh, np.linalg.norm(offsets[:, 15], axis=1) / 100, rtol=1e-9)
 
 
-def test_squat_goes_down_and_up(shared_data):
-    take = load_take(shared_data / "kinect_v2_vicon_uiprmd" / "Kinect" / "m01_s01_e01_positions.txt")
+def test_squat_goes_down_and_up(data_dir):
+    take = load_take(data_dir / "kinect_v2_vicon_uiprmd" / "Kinect" / "m01_s01_e01_positions.txt")
     hips = take.positions[:, KINECT_V2.index("SpineBase"), 1]
     assert hips.max() - hips.min() > 0.3  # a deep squat lowers the hips by well over 30 cm
     assert np.argmin(hips) not in (0, take.frame_count - 1)
 
 
-def test_errors(shared_data, tmp_path):
-    folder = shared_data / "kinect_v2_vicon_uiprmd" / "Kinect"
+def test_errors(data_dir, tmp_path):
+    folder = data_dir / "kinect_v2_vicon_uiprmd" / "Kinect"
     shutil.copy(folder / "m07_s01_e01_positions.txt", tmp_path / "m07_s01_e01_positions.txt")
     with pytest.raises(TakeError, match=r"m07_s01_e01_angles\.txt not found"):
         load_take(tmp_path / "m07_s01_e01_positions.txt")
@@ -70,8 +70,8 @@ def test_errors(shared_data, tmp_path):
     ("garbage", r"positions\.txt:13: non-numeric value 'oops'"),
     ("columns", r"positions\.txt:13: expected 66 values, found 65"),
 ])
-def test_corrupted_positions_name_the_line(shared_data, tmp_path, how, pattern):
-    folder = shared_data / "kinect_v2_vicon_uiprmd" / "Kinect"
+def test_corrupted_positions_name_the_line(data_dir, tmp_path, how, pattern):
+    folder = data_dir / "kinect_v2_vicon_uiprmd" / "Kinect"
     shutil.copy(folder / "m01_s01_e01_angles.txt", tmp_path / "m01_s01_e01_angles.txt")
     lines = (folder / "m01_s01_e01_positions.txt").read_text().splitlines(keepends=True)
     fields = lines[12].strip().split(",")

@@ -10,13 +10,13 @@ from tests.takes import format_fixtures as fx
 FRAMES = 60
 
 
-def performers(shared_data: Path):
+def performers(data_dir: Path):
     """(body 0, body 1) as read from their CSV files, 60 frames each."""
-    return tuple(kinect_v2_csv.read(shared_data / "kinect_v2" / name).slice(slice(10, 10 + FRAMES))
+    return tuple(kinect_v2_csv.read(data_dir / "kinect_v2" / name).slice(slice(10, 10 + FRAMES))
                  for name in ("Ges01_wavehand.csv", "Ges04_comehere.csv"))
 
 
-def write_two_person_ntu(shared_data: Path, path: Path) -> Path:
-    first, second = performers(shared_data)
+def write_two_person_ntu(data_dir: Path, path: Path) -> Path:
+    first, second = performers(data_dir)
     fx.write_ntu(first, path, second_body=slice(0, FRAMES), second=second)
     return path
