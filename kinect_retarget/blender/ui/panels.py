@@ -13,13 +13,14 @@ from .source_overlay import draw_settings as draw_source_settings
 from .properties import target_armature
 
 
-class _KinectPanel:
+class KinectSidebarPanel:
+    """Where every Kinect panel sits: the 3D View sidebar's Kinect tab (mixed into each Panel class)."""
     bl_space_type = "VIEW_3D"
     bl_region_type = "UI"
     bl_category = "Kinect"
 
 
-class KINECT_RETARGET_PT_main(_KinectPanel, bpy.types.Panel):
+class KINECT_RETARGET_PT_main(KinectSidebarPanel, bpy.types.Panel):
     bl_label = "Kinect Retarget"
 
     def draw(self, context):
@@ -95,7 +96,7 @@ class KINECT_RETARGET_PT_main(_KinectPanel, bpy.types.Panel):
             col.label(text=st["message"], icon="INFO")
 
 
-class KINECT_RETARGET_PT_target(_KinectPanel, bpy.types.Panel):
+class KINECT_RETARGET_PT_target(KinectSidebarPanel, bpy.types.Panel):
     bl_label = "Target"
     bl_parent_id = "KINECT_RETARGET_PT_main"
 
@@ -115,7 +116,7 @@ class KINECT_RETARGET_PT_target(_KinectPanel, bpy.types.Panel):
         draw_performers(layout, s)
 
 
-class KINECT_RETARGET_PT_mapping(_KinectPanel, bpy.types.Panel):
+class KINECT_RETARGET_PT_mapping(KinectSidebarPanel, bpy.types.Panel):
     bl_label = "Bone Mapping"
     bl_parent_id = "KINECT_RETARGET_PT_main"
     bl_options = {"DEFAULT_CLOSED"}
@@ -139,7 +140,7 @@ class KINECT_RETARGET_PT_mapping(_KinectPanel, bpy.types.Panel):
             layout.label(text="Empty table: the preset maps every bone", icon="INFO")
 
 
-class KINECT_RETARGET_PT_options(_KinectPanel, bpy.types.Panel):
+class KINECT_RETARGET_PT_options(KinectSidebarPanel, bpy.types.Panel):
     bl_label = "Filter, Root and Recording"
     bl_parent_id = "KINECT_RETARGET_PT_main"
     bl_options = {"DEFAULT_CLOSED"}
@@ -164,7 +165,7 @@ class KINECT_RETARGET_PT_options(_KinectPanel, bpy.types.Panel):
         col.prop(s, "bake_on_stop")
 
 
-class KINECT_RETARGET_PT_bake(_KinectPanel, bpy.types.Panel):
+class KINECT_RETARGET_PT_bake(KinectSidebarPanel, bpy.types.Panel):
     """Options of Bake Take and of the bake when a recording stops (the take range applies to Bake Take)."""
     bl_label = "Bake"
     bl_parent_id = "KINECT_RETARGET_PT_main"

@@ -11,6 +11,7 @@ from bpy.props import IntProperty, StringProperty
 from ...core.take import TakeError
 from ...takes import load_take
 from .bake_settings import BakeOptionProps
+from .panels import KinectSidebarPanel
 
 
 def add_take(scene: bpy.types.Scene, path: str) -> None:
@@ -156,10 +157,7 @@ class KINECT_RETARGET_OT_take_delete(_TakeOperator, bpy.types.Operator):
         return {"FINISHED"}
 
 
-class KINECT_RETARGET_PT_takes(bpy.types.Panel):
-    bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "Kinect"
+class KINECT_RETARGET_PT_takes(KinectSidebarPanel, bpy.types.Panel):
     bl_label = "Takes"
     bl_parent_id = "KINECT_RETARGET_PT_main"
 

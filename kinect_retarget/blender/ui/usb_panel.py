@@ -12,6 +12,7 @@ from ...device import KinectError, MotorUnavailable
 from ...device.motor import LED_MODES, TILT_LIMIT_DEG
 from ...sources import SourceError
 from ..live import usb_service
+from .panels import KinectSidebarPanel
 
 LED_ITEMS = [(m, m.replace("-", " ").title(), f"Kinect LED: {m}") for m in
              ("green", "red", "yellow", "blink-green", "blink-red-yellow", "off")]
@@ -130,10 +131,7 @@ def _wrapped(layout, text: str, icon: str = "NONE", width_px: int = 280, alert: 
         col.label(text=line, icon=icon if n == 0 else "BLANK1")
 
 
-class KINECT_RETARGET_PT_usb(bpy.types.Panel):
-    bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "Kinect"
+class KINECT_RETARGET_PT_usb(KinectSidebarPanel, bpy.types.Panel):
     bl_label = "USB Kinect"
     bl_parent_id = "KINECT_RETARGET_PT_main"
 
