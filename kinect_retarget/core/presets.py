@@ -10,6 +10,7 @@ import json
 import os
 from pathlib import Path
 
+from ..assets import ASSETS_DIR
 from .skeletons import KINECT_V1, KINECT_V2
 
 
@@ -25,7 +26,7 @@ def _sides(table: dict[str, str], left: str, right: str) -> dict[str, str]:
     return out
 
 
-PRESET_DIR = Path(__file__).resolve().parent.parent / "assets" / "presets"
+PRESET_DIR = ASSETS_DIR / "presets"
 
 
 def load_preset_files(folder: Path = PRESET_DIR) -> dict[str, dict[str, str]]:

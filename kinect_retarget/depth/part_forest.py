@@ -14,9 +14,11 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..assets import ASSETS_DIR
+
 BACKGROUND_DEPTH = 10.0   # metres read at a probe off the person or off the image
 # shipped with the package's runtime assets (kinect_retarget/assets, credits and recipe in its CREDITS.md)
-MODEL_PATH = os.path.join(os.path.dirname(os.path.dirname(__file__)), "assets", "body_parts_forest.npz")
+MODEL_PATH = os.fspath(ASSETS_DIR / "body_parts_forest.npz")
 
 
 def probe_features(zb: np.ndarray, rows: np.ndarray, cols: np.ndarray, offsets: np.ndarray, cells_per_m: float):
