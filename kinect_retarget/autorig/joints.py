@@ -15,6 +15,7 @@ import numpy as np
 
 from ..core.skeletons import KINECT_V1
 from .features import FeaturePoints
+from .mesh import triangle_areas
 
 # Ring positions as fractions of the body's geodesic length L (head top to feet, along the surface). The
 # surface barely stretches when a body moves, so these hold from A-pose to T-pose to a split (the branch
@@ -40,8 +41,7 @@ SPINE_BACK = 0.25        # Spine: this far from the back to the belly (measured 
 def vertex_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """A third of the area of each triangle around each vertex: centroids weighted by it do not drift
     toward the finely meshed side of a ring (faces, hands and seams are often denser)."""
-    t = vertices[faces]
-    area = 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
+    area = triangle_areas(vertices, faces)
     return np.bincount(faces.ravel(), np.repeat(area / 3, 3), len(vertices))
 
 

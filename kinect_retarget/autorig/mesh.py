@@ -62,6 +62,12 @@ def subdivide(mesh: Mesh, face_mask: np.ndarray | None = None) -> Mesh:
     return Mesh(verts, np.concatenate([mesh.faces[~chosen]] + new), mesh.name + "-subdivided")
 
 
+def triangle_areas(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(F,) area of each triangle of `faces` (F, 3)."""
+    t = vertices[faces]
+    return 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
+
+
 def nearest_vertex(points: np.ndarray, targets: np.ndarray, chunk: int = 1024) -> np.ndarray:
     """Index of the nearest target for each point (brute force in float32 chunks: no scipy in Blender)."""
     out = np.empty(len(points), dtype=np.int64)

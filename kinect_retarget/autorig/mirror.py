@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.skeletons import KINECT_V1
+from .mesh import triangle_areas
 
 MIRROR_TOLERANCE = 0.003  # of height (5 mm on 1.7 m): surface mismatch allowed for a body to count as mirrored
 COVERAGE = 0.99           # fraction of the sampled vertices that must be within the tolerance
@@ -48,7 +49,7 @@ def surface_moments(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray
     """The surface's area centroid and principal axes (columns), from each triangle's exact second moment
     (independent of how the surface is cut into triangles)."""
     t = vertices[faces]
-    area = 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
+    area = triangle_areas(vertices, faces)
     total = max(area.sum(), 1e-30)
     mid = t.mean(axis=1)
     centroid = (area[:, None] * mid).sum(axis=0) / total
