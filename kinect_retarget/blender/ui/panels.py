@@ -9,15 +9,9 @@ from ..live.osc_access import osc_host
 from .bake_settings import draw_bake_options
 from .performers import draw_performers
 from .preferences import get_preferences
-from .source_overlay import draw_settings as draw_source_settings
 from .properties import target_armature
-
-
-class KinectSidebarPanel:
-    """Where every Kinect panel sits: the 3D View sidebar's Kinect tab (mixed into each Panel class)."""
-    bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "Kinect"
+from .sidebar_panel import KinectSidebarPanel
+from .source_overlay import draw_settings as draw_source_settings
 
 
 class KINECT_RETARGET_PT_main(KinectSidebarPanel, bpy.types.Panel):

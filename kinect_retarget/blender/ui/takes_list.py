@@ -11,7 +11,7 @@ from bpy.props import IntProperty, StringProperty
 from ...core.take import TakeError
 from ...takes import load_take
 from .bake_settings import BakeOptionProps
-from .panels import KinectSidebarPanel
+from .sidebar_panel import KinectSidebarPanel
 
 
 def add_take(scene: bpy.types.Scene, path: str) -> None:

@@ -12,7 +12,7 @@ from ...device import KinectError, MotorUnavailable
 from ...device.motor import LED_MODES, TILT_LIMIT_DEG
 from ...sources import SourceError
 from ..live import usb_service
-from .panels import KinectSidebarPanel
+from .sidebar_panel import KinectSidebarPanel
 
 LED_ITEMS = [(m, m.replace("-", " ").title(), f"Kinect LED: {m}") for m in
              ("green", "red", "yellow", "blink-green", "blink-red-yellow", "off")]
