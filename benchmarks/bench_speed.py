@@ -10,6 +10,7 @@ import time
 import numpy as np
 from _common import SAMPLE_TAKES, best_of
 
+from kinect_retarget.core.bake_options import BakeOptions
 from kinect_retarget.core.kinect_rig_layout import generated_mapping, generated_rig, median_segment_lengths
 from kinect_retarget.core.pipeline import RetargetPipeline, RetargetSettings
 from kinect_retarget.core.quat import to_matrix
@@ -100,12 +101,13 @@ def main() -> None:
 
     from kinect_retarget.blender.bake_take import bake_take, new_generated_rig
 
-    def ours():
+    def ours(feet):
         bpy.ops.wm.read_factory_settings(use_empty=True)
         t0, c0 = time.perf_counter(), time.process_time()
         tk = load_take(take_path)
         obj = new_generated_rig(bpy.context.scene, tk)
-        bake_take(obj, tk, preset="kinect", settings=RetargetSettings(filter="default"))
+        bake_take(obj, tk, preset="kinect", settings=RetargetSettings(filter="default"),
+                  options=BakeOptions(feet=feet))
         return time.perf_counter() - t0, time.process_time() - c0
 
     def importer():
@@ -116,13 +118,18 @@ def main() -> None:
         bpy.ops.import_anim.bvh(filepath=bvh_path, rotate_mode="QUATERNION")
         return time.perf_counter() - t0, time.process_time() - c0
 
-    ours_t = np.min([ours() for _ in range(3)], axis=0)
+    # The importer keys what the file says; the like-for-like bake does the same work (feet off). The default
+    # bake also plants the feet (issue 16), an extra pass the importer has no counterpart for: printed beside it.
+    same_t = np.min([ours("off") for _ in range(3)], axis=0)
+    lock_t = np.min([ours("lock") for _ in range(3)], axis=0)
     bvh_t = np.min([importer() for _ in range(3)], axis=0)
-    print(f"bake 10,000 frames end to end (read .krtake, default filter, retarget, bulk keys, rig build): "
-          f"{ours_t[0]:.3f} s wall, {ours_t[1]:.3f} s CPU")
+    print(f"bake 10,000 frames end to end (read .krtake, default filter, retarget, bulk keys, rig build), feet off: "
+          f"{same_t[0]:.3f} s wall, {same_t[1]:.3f} s CPU")
+    print(f"the same with the default feet lock: {lock_t[0]:.3f} s wall, {lock_t[1]:.3f} s CPU")
     print(f"Blender BVH importer, same 10,000 frames x 20 joints (QUATERNION): {bvh_t[0]:.3f} s wall, "
           f"{bvh_t[1]:.3f} s CPU")
-    print(f"ratio ours / importer: {ours_t[0] / bvh_t[0]:.3f} wall, {ours_t[1] / bvh_t[1]:.3f} CPU (goal <= 0.2)")
+    print(f"ratio ours (feet off) / importer: {same_t[0] / bvh_t[0]:.3f} wall, {same_t[1] / bvh_t[1]:.3f} CPU "
+          f"(goal <= 0.2); with feet lock: {lock_t[0] / bvh_t[0]:.3f} wall, {lock_t[1] / bvh_t[1]:.3f} CPU")
 
 
 if __name__ == "__main__":
