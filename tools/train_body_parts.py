@@ -1,23 +1,35 @@
 """Train the body-part forest the depth tracker ships (kinect_retarget/assets/body_parts_forest.npz).
 
-    .venv/bin/python tools/train_body_parts.py [--images 400] [--pixels 500] [--trees 3] [--depth 20]
-                                               [--seed 0] [--out PATH] [--cache /tmp/body_parts_data.npz]
+    .venv/bin/python tools/train_body_parts.py [--images 6000] [--pixels 400] [--trees 3] [--depth 20]
+                                               [--seed 0] [--jobs 2] [--out PATH] [--cache DIR]
+    .venv/bin/python tools/train_body_parts.py --evaluate FOREST.npz [FOREST.npz ...] [--images 300] [--seed 99]
+                                               [--plain]
 
 Development only: needs scikit-learn (requirements-train.txt; PYTHONPATH may point at a separate install),
-which the package never imports. Training data come only from redistributable assets in ../shared/data:
-the MakeHuman base mesh (CC0) posed by the CMU BVH motions (every 8th frame), with each arm (and sometimes a
-leg) swung to random directions so the arm poses of real actions are covered; bodies scaled 1.45-2.0 m and
-thickened or thinned per bone (0.85-1.3); performers 1.5-4 m away, up to side-on, sensor 0.6-1.6 m high and
-pitched -5..20 degrees; the sensor's projector shadow, edge dropouts, disparity noise and quantisation
-(render.kinect_artifacts). Labels: body_parts.PARTS from the mesh's skin weights (sim/body_part_labels.py). Each
-image's person cells on the tracker's 4-pixel grid are sampled, and a pool of depth-difference features is
-evaluated on them; scikit-learn's RandomForestClassifier picks from the pool at every split; the trees are
-flattened into numpy arrays (part_forest.PartForest). Seeded: the same arguments give the same trees (only
-the times recorded in the recipe differ).
+which the package never imports. Training data come only from redistributable assets: the MakeHuman base mesh
+(CC0) as a population (sim/body_population.py): per-segment proportions (upper arm, forearm, hand, thigh,
+shin, torso length, shoulder and hip width), per-bone girth 0.85-1.3, loose clothing and hair as offset
+surfaces and sometimes a skirt/coat hem, height 1.45-2.0 m, a new performer every 10 images. Poses: every
+4th frame of the CMU BVH motions in ../shared/data/mocap_bvh and every frame of the Kinect v2 (LabanotationSuite
+CSV, Kinectron JSON) and UI-PRMD Kinect recordings, through the project's own take readers and mocap poser
+(sim/mocap_pose.pose_from_points), mirrored half the time; arms (and sometimes legs) swung to random
+directions (CMU p 0.7, Kinect p 0.35) so the arm poses of real actions are covered. Performers 1.5-4 m away,
+turned up to side-on, sensor 0.6-1.6 m high and pitched -5..20 degrees; the sensor's projector shadow,
+edge dropouts, disparity noise and quantisation (sim/depth_render.kinect_artifacts). Labels:
+body_parts.PARTS from the mesh's skin weights (sim/body_part_labels.py). Each image's person cells on the
+tracker's 4-pixel grid are sampled, and a pool of depth-difference features is evaluated on them;
+scikit-learn's RandomForestClassifier picks from the pool at every split; the trees are flattened into numpy
+arrays (part_forest.PartForest).
+
+Seeded: image i and performer g draw from their own generators (seed, i) and (seed, g), so the same
+arguments give the same data (and trees) whatever --jobs is; --cache DIR keeps 50-image chunks and resumes.
+--evaluate renders held-out images (use a seed not trained on) and prints each forest's per-cell accuracy;
+--plain renders the older population (MakeHuman girth and scale only, CMU poses) for comparison.
 """
 from __future__ import annotations
 
 import argparse
+import multiprocessing
 import sys
 import time
 from dataclasses import replace
@@ -29,34 +41,51 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 DATA = REPO.parent / "shared" / "data"
 
+from kinect_retarget.assets import MAKEHUMAN_DIR  # noqa: E402
 from kinect_retarget.depth.body_parts import BACKGROUND, PARTS  # noqa: E402
 from kinect_retarget.depth.depth_camera import DepthCamera, raw_to_mm  # noqa: E402
-from kinect_retarget.depth.part_forest import BACKGROUND_DEPTH, MODEL_PATH, PartForest, probe_features  # noqa: E402
+from kinect_retarget.depth.part_forest import BACKGROUND_DEPTH, MODEL_PATH, PartForest, load_forest, probe_features  # noqa: E402
 from kinect_retarget.depth.segmentation import DepthGrid  # noqa: E402
 from kinect_retarget.sim.body_part_labels import render_parts, surface_labels, vertex_parts  # noqa: E402
+from kinect_retarget.sim.body_population import clothed_body, proportioned_body, random_proportions, take_points  # noqa: E402
 from kinect_retarget.sim.bvh_motion import read_bvh_positions  # noqa: E402
 from kinect_retarget.sim.depth_render import _tilt, kinect_artifacts, quad_sampler, surface_points  # noqa: E402
 from kinect_retarget.sim.makehuman_body import DRIVER_NAMES, load_body  # noqa: E402
 from kinect_retarget.sim.mocap_pose import _rest_points, cmu_points, pose_from_points  # noqa: E402
+from kinect_retarget.takes import load_take  # noqa: E402
 
 CLIPS = ("01_01", "131_01", "131_02", "131_03")
+TAKES = tuple(f"kinect_v2/{n}" for n in ("Ges01_wavehand.csv", "Ges02_balancinghands.csv", "Ges03_drawlines.csv",
+                                         "Ges04_comehere.csv", "Ges05_demopoint.csv", "Ges06_chickenwing.csv",
+                                         "joints.csv", "recorded_skeleton.json")) + tuple(
+    f"kinect_v2_vicon_uiprmd/Kinect/m{m:02d}_s01_e01_positions.txt" for m in (1, 5, 7))
 STEP = 4            # the tracker's grid stride
 POOL = 400          # candidate features
 MAX_OFFSET = 0.6    # metres
+PER_BODY = 10       # images per performer
+CHUNK = 50          # images per cache file
+TAKE_SHARE = 0.5    # share of images posed from the Kinect recordings (the rest from CMU)
 
 
 def _unit(v):
     return v / max(np.linalg.norm(v), 1e-9)
 
 
-def load_poses() -> list[dict]:
-    """One dict of canonical mocap points (each (3,)) per pose: every 8th frame of every clip."""
-    poses = []
+def load_poses(plain: bool = False) -> tuple[list[dict], list[dict]]:
+    """(CMU poses, Kinect recording poses): dicts of canonical mocap points (each (3,))."""
+    cmu = []
     for clip in CLIPS:
         names, _, pos, _ = read_bvh_positions(str(DATA / "mocap_bvh" / f"{clip}.bvh"))
-        pts = cmu_points(names, pos[::8])
-        poses += [{k: v[i] for k, v in pts.items()} for i in range(len(pos[::8]))]
-    return poses
+        pts = cmu_points(names, pos[:: 8 if plain else 4])
+        cmu += [{k: v[i] for k, v in pts.items()} for i in range(len(pts["hips"]))]
+    takes = [] if plain else [p for t in TAKES for p in take_points(load_take(DATA / t))]
+    return cmu, takes
+
+
+def mirrored(p: dict) -> dict:
+    """The pose mirrored left-right (X negated, sides swapped)."""
+    swap = {"L": "R", "R": "L"}
+    return {(k[:-1] + swap[k[-1]] if k[-2:] in (".L", ".R") else k): v * [-1.0, 1.0, 1.0] for k, v in p.items()}
 
 
 def random_direction(rng, around=None, max_deg=180.0):
@@ -68,12 +97,12 @@ def random_direction(rng, around=None, max_deg=180.0):
             return d
 
 
-def swing_limbs(p: dict, rng) -> dict:
-    """Each arm (p 0.7) and leg (p 0.2) swung to random directions with its own bone lengths."""
+def swing_limbs(p: dict, rng, arm_chance: float = 0.7) -> dict:
+    """Each arm (p arm_chance) and leg (p 0.2) swung to random directions with its own bone lengths."""
     p = dict(p)
     up = _unit(p["neck"] - p["hips"])
     for s in ("L", "R"):
-        if rng.random() < 0.7:
+        if rng.random() < arm_chance:
             a, b, c, d = (p[f"{k}.{s}"] for k in ("shoulder", "elbow", "wrist", "hand"))
             upper = random_direction(rng)
             fore = random_direction(rng, upper, 150.0)
@@ -112,12 +141,27 @@ def varied_body(body, rng):
     return replace(body, rest_vertices=v + np.einsum("vd,dvc->vc", body.weights, disp))
 
 
-def render_one(body, vlabels_pts, groups, pose, rng, cam):
+def performer(base, vlab, rng, cam, plain: bool = False):
+    """One random performer: (body, surface sample groups, their labels, metres per body unit)."""
+    body, labels = base, vlab
+    if not plain:
+        body = proportioned_body(body, random_proportions(rng), str(MAKEHUMAN_DIR))
+    body = varied_body(body, rng)
+    if not plain:
+        body, labels = clothed_body(body, labels, rng)
+    groups = quad_sampler(body.rest_vertices, body.quads, 1.2, cam)
+    height = rng.uniform(1.45, 2.0)   # MakeHuman's base body is about 1.67 m tall
+    rest_height = 1.67 if plain else np.ptp(base.rest_vertices[:, 1]) * (np.ptp(body.rest_vertices[:, 1]) /
+                                                                          np.ptp(base.rest_vertices[:, 1]))
+    return body, groups, surface_labels(labels, body.quads, groups), height / rest_height
+
+
+def render_one(body, vlabels_pts, groups, pose, rng, cam, scale=None):
     """One random frame: (depth mm (480, 640), labels (480, 640))."""
     posed = pose_from_points(body, {k: v[None] for k, v in pose.items()})
     verts = posed.vertices(body, slice(0, 1))[0]
     j = posed.joints[0]
-    verts = (verts - j[0]) * rng.uniform(1.45, 2.0) / 1.67   # MakeHuman's base body is about 1.67 m tall
+    verts = (verts - j[0]) * (rng.uniform(1.45, 2.0) / 1.67 if scale is None else scale)
     lat_dir = pose["hip.L"] - pose["hip.R"]
     heading = np.arctan2(np.cross(lat_dir, [0, 1, 0])[0], np.cross(lat_dir, [0, 1, 0])[2])
     turn = np.pi - heading + np.radians(np.clip(rng.normal(0, 35), -95, 95))
@@ -127,7 +171,7 @@ def render_one(body, vlabels_pts, groups, pose, rng, cam):
     verts[:, 1] -= sensor_h + verts[:, 1].min()
     x = rng.uniform(-0.3, 0.3)
     whole = rng.random() < 0.9   # most frames show the whole body, like the real sequences
-    for dist in np.arange(rng.uniform(1.5, 4.0), 6.0, 0.1):   # back off until the body is in view
+    for dist in np.arange(rng.uniform(1.5, 4.0), 4.4, 0.1):   # back off until the body is in view (or in range)
         cam_v = (verts + [x * dist, 0.0, dist]) @ _tilt(tilt)   # level frame -> camera frame
         uv = cam_v[:, :2] / cam_v[:, 2:] * cam.f
         if not whole or (np.all(np.abs(uv[:, 0]) < cam.cx - 4) and np.all(np.abs(uv[:, 1]) < cam.cy - 4)):
@@ -140,37 +184,110 @@ def render_one(body, vlabels_pts, groups, pose, rng, cam):
     return mm, labels
 
 
-def make_data(args, rng):
+_W: dict = {}   # per-process state, set before the worker pool forks
+
+
+def _setup(seed: int, plain: bool) -> None:
     cam = DepthCamera()
-    base = load_body(str(DATA / "meshes" / "makehuman"))
-    vlab = vertex_parts(base)
-    poses = load_poses()
-    offsets = rng.uniform(-MAX_OFFSET, MAX_OFFSET, size=(POOL, 2, 2))
-    offsets[: POOL // 3, 1] = 0.0   # a third compare with the cell itself (Shotton's unary features)
-    cells_per_m = cam.f / STEP
-    xs, ys = [], []
-    t0 = time.perf_counter()
-    body = base
-    for i in range(args.images):
-        if i % 10 == 0:   # a new body shape every 10 images
-            body = varied_body(base, rng)
-            groups = quad_sampler(body.rest_vertices, body.quads, 1.2, cam)
-            vlabels_pts = surface_labels(vlab, body.quads, groups)
-        mm, labels = render_one(body, vlabels_pts, groups, swing_limbs(poses[rng.integers(len(poses))], rng),
-                                rng, cam)
+    base = load_body(str(MAKEHUMAN_DIR))
+    cmu, takes = load_poses(plain)
+    _W.update(cam=cam, base=base, vlab=vertex_parts(base), cmu=cmu, takes=takes, seed=seed, plain=plain)
+
+
+def person_grids(first: int, count: int):
+    """Images first..first+count-1: [(person depth grid zb, grid labels)], each from its own seeded draws."""
+    cam, seed, out = _W["cam"], _W["seed"], []
+    body = None
+    for i in range(first, first + count):
+        if body is None or i % PER_BODY == 0:
+            body = performer(_W["base"], _W["vlab"], np.random.default_rng([seed, 2, i // PER_BODY]), cam,
+                             _W["plain"])
+        rng = np.random.default_rng([seed, 1, i])
+        use_takes = bool(_W["takes"]) and rng.random() < TAKE_SHARE
+        poses = _W["takes"] if use_takes else _W["cmu"]
+        pose = poses[rng.integers(len(poses))]
+        if not _W["plain"] and rng.random() < 0.5:
+            pose = mirrored(pose)
+        b, groups, vl, scale = body
+        mm, labels = render_one(b, vl, groups, swing_limbs(pose, rng, 0.35 if use_takes else 0.7), rng, cam,
+                                scale)
         grid = DepthGrid.from_mm(mm, cam, STEP)
         glab = labels[STEP // 2::STEP, STEP // 2::STEP]
         person = grid.valid & (glab != BACKGROUND)
-        zb = np.where(person, grid.z, BACKGROUND_DEPTH)
-        r, c = np.nonzero(person)
+        out.append((np.where(person, grid.z, BACKGROUND_DEPTH).astype(np.float32), np.where(person, glab, BACKGROUND)))
+    return out
+
+
+def _chunk_samples(task):
+    first, count, pixels, offsets, cache = task
+    path = Path(cache) / f"chunk_{first:06d}_{count}_{pixels}.npz" if cache else None
+    if path is not None and path.exists():
+        with np.load(path) as d:
+            return d["x"], d["y"]
+    cells_per_m, xs, ys = _W["cam"].f / STEP, [], []
+    for i, (zb, glab) in enumerate(person_grids(first, count)):
+        r, c = np.nonzero(glab != BACKGROUND)
         if len(r) < 50:
             continue
-        pick = rng.choice(len(r), size=min(args.pixels, len(r)), replace=False)
-        xs.append(probe_features(zb, r[pick], c[pick], offsets[None], cells_per_m).astype(np.float32))
+        pick = np.random.default_rng([_W["seed"], 3, first + i]).choice(len(r), size=min(pixels, len(r)),
+                                                                        replace=False)
+        xs.append(probe_features(zb.astype(np.float64), r[pick], c[pick], offsets[None], cells_per_m)
+                  .astype(np.float32))
         ys.append(glab[r[pick], c[pick]])
-        if (i + 1) % 20 == 0:
-            print(f"  {i + 1}/{args.images} images, {time.perf_counter() - t0:.0f} s", flush=True)
-    return np.concatenate(xs), np.concatenate(ys), offsets
+    x, y = np.concatenate(xs), np.concatenate(ys)
+    if path is not None:
+        np.savez(path, x=x, y=y)
+    return x, y
+
+
+def _pool(jobs: int):
+    return multiprocessing.get_context("fork").Pool(jobs) if jobs > 1 else None
+
+
+def make_data(args):
+    offsets = np.random.default_rng([args.seed, 0]).uniform(-MAX_OFFSET, MAX_OFFSET, size=(POOL, 2, 2))
+    offsets[: POOL // 3, 1] = 0.0   # a third compare with the cell itself (Shotton's unary features)
+    if args.cache:
+        Path(args.cache).mkdir(parents=True, exist_ok=True)
+    tasks = [(f, min(CHUNK, args.images - f), args.pixels, offsets, args.cache) for f in range(0, args.images, CHUNK)]
+    _setup(args.seed, False)
+    pool = _pool(args.jobs)
+    results, t0 = [], time.perf_counter()
+    for k, res in enumerate(pool.imap(_chunk_samples, tasks) if pool else map(_chunk_samples, tasks)):
+        results.append(res)
+        print(f"  {min((k + 1) * CHUNK, args.images)}/{args.images} images, {time.perf_counter() - t0:.0f} s",
+              flush=True)
+    if pool:
+        pool.close()
+    return np.concatenate([r[0] for r in results]), np.concatenate([r[1] for r in results]), offsets
+
+
+def evaluate(args) -> None:
+    """Per-cell accuracy of each forest on held-out renders (seed args.seed, population per args.plain)."""
+    forests = {p: load_forest(p) for p in args.evaluate}
+    _setup(args.seed, args.plain)
+    pool = _pool(args.jobs)
+    tasks = [(f, min(CHUNK, args.images - f)) for f in range(0, args.images, CHUNK)]
+    grids = [g for part in (pool.starmap(person_grids, tasks) if pool else [person_grids(*t) for t in tasks])
+             for g in part]
+    cells_per_m = _W["cam"].f / STEP
+    for path, forest in forests.items():
+        if forest is None:
+            print(f"{path}: missing or unreadable")
+            continue
+        hit = np.zeros(len(PARTS))
+        seen = np.zeros(len(PARTS))
+        t0 = time.perf_counter()
+        for zb, glab in grids:
+            r, c = np.nonzero(glab != BACKGROUND)
+            pred = np.argmax(forest.classify(zb.astype(np.float64), r, c, cells_per_m), axis=1)
+            np.add.at(seen, glab[r, c], 1)
+            np.add.at(hit, glab[r, c], pred == glab[r, c])
+        ms = (time.perf_counter() - t0) / len(grids) * 1e3
+        print(f"{path}: per-cell accuracy {hit.sum() / seen.sum():.3f}, mean over parts "
+              f"{np.mean(hit[seen > 0] / seen[seen > 0]):.3f} ({int(seen.sum())} cells, {len(grids)} images, "
+              f"{'plain' if args.plain else 'population'} renders, seed {args.seed}; {ms:.1f} ms an image)")
+        print("  per part: " + ", ".join(f"{PARTS[k]} {hit[k] / seen[k]:.2f}" for k in range(len(PARTS)) if seen[k]))
 
 
 def flatten(forest, offsets) -> PartForest:
@@ -199,27 +316,29 @@ def flatten(forest, offsets) -> PartForest:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--images", type=int, default=400)
-    ap.add_argument("--pixels", type=int, default=500, help="person cells sampled per image")
+    ap.add_argument("--images", type=int, default=6000)
+    ap.add_argument("--pixels", type=int, default=400, help="person cells sampled per image")
     ap.add_argument("--trees", type=int, default=3)
     ap.add_argument("--depth", type=int, default=20)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--jobs", type=int, default=2, help="rendering processes (the data do not depend on it)")
     ap.add_argument("--out", default=MODEL_PATH)
-    ap.add_argument("--cache", help="keep the sampled features here (.npz) and reuse them when present")
+    ap.add_argument("--cache", help="directory keeping the sampled features of each 50-image chunk (resumes)")
+    ap.add_argument("--data-only", action="store_true", help="render and sample (into --cache), do not train")
+    ap.add_argument("--evaluate", nargs="+", metavar="FOREST", help="per-cell accuracy on held-out renders")
+    ap.add_argument("--plain", action="store_true", help="--evaluate on the older, plainer population")
     args = ap.parse_args()
-    from sklearn.ensemble import RandomForestClassifier
-    rng = np.random.default_rng(args.seed)
+    if args.evaluate:
+        evaluate(args)
+        return
     t0 = time.perf_counter()
-    if args.cache and Path(args.cache).exists():
-        with np.load(args.cache) as d:
-            x, y, offsets = d["x"], d["y"], d["offsets"]
-    else:
-        x, y, offsets = make_data(args, rng)
-        if args.cache:
-            np.savez(args.cache, x=x, y=y, offsets=offsets)
+    x, y, offsets = make_data(args)
     t1 = time.perf_counter()
-    print(f"{len(y)} samples from {args.images} images ({t1 - t0:.0f} s); training {args.trees} trees of depth "
-          f"{args.depth} on {x.shape[1]} candidate features", flush=True)
+    print(f"{len(y)} samples from {args.images} images ({t1 - t0:.0f} s)", flush=True)
+    if args.data_only:
+        return
+    from sklearn.ensemble import RandomForestClassifier
+    print(f"training {args.trees} trees of depth {args.depth} on {x.shape[1]} candidate features", flush=True)
     rf = RandomForestClassifier(n_estimators=args.trees, max_depth=args.depth, max_features=40,
                                 min_samples_leaf=5, random_state=args.seed, n_jobs=1).fit(x, y)
     forest = flatten(rf, offsets)
