@@ -15,7 +15,7 @@ from ..core.key_reduction import Reduction, reduce_keys
 from ..core.foot_lock import FeetReport, FootLock, key_rate
 from ..core.kinect_rig_layout import median_segment_lengths
 from ..core.pipeline import BakedMotion, RetargetPipeline, RetargetSettings
-from ..core.presets import PRESET_INFO, build_mapping, mapping_problems
+from ..core.presets import PRESET_INFO, STRUCTURE, build_mapping, mapping_problems
 from ..core.resample import resample_motion
 from ..core.root_motion import apply_root_motion, root_follows_by_constraints
 from ..core.rotation_modes import channel_values
@@ -133,7 +133,7 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
     if progress:
         progress(0.3)
     extra = []
-    if used == "rigify":
+    if used in ("rigify", STRUCTURE):  # Rigify's limbs switched to FK (no switch on other rigs)
         extra = [(f'pose.bones["{escape_identifier(b)}"]["IK_FK"]', b, np.ones(1)) for b in fk_switch_bones(obj)]
     root_named = options.root_bone or PRESET_INFO.get(used, {}).get("root_motion_bone")  # Mannequin's, Rigify's root
     root_note = ""

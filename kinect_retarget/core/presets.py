@@ -137,9 +137,10 @@ def mapping_problems(bone_names, overrides: dict[str, str] | None) -> list[str]:
 
 
 def structure_mapping(rig) -> dict[str, str]:
-    """The mapping of a TargetRig found from its hierarchy and rest pose (ValueError: not a humanoid)."""
-    from .armature_mapping import structure_mapping_for
-    return structure_mapping_for(rig.bone_names, rig.parents, rig.heads, rig.tails).mapping
+    """The mapping of a TargetRig found from its hierarchy and rest pose, and on a control rig (Rigify's) from
+    its deform bones and constraints too (ValueError: not a humanoid)."""
+    from .control_rig_mapping import map_armature
+    return map_armature(rig.bone_names, rig.parents, rig.heads, rig.tails, getattr(rig, "links", None)).mapping
 
 
 def build_mapping(preset: str, bone_names, overrides: dict[str, str] | None = None,

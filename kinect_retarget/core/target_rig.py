@@ -2,8 +2,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .control_rig_mapping import RigLinks
 
 
 @dataclass
@@ -11,7 +15,8 @@ class TargetRig:
     """bone_names (B,); parents (B,) index or -1; rest (B, 4, 4) armature-space rest matrices
     (Blender's Bone.matrix_local: column 1 of the 3x3 part is the bone's Y axis, head -> tail);
     lengths (B,); object_matrix (4, 4) the armature object's world matrix; inherit_rotation (B,) bool.
-    `generated` marks the project's own Kinect rig (root scale n = 1)."""
+    `generated` marks the project's own Kinect rig (root scale n = 1); `links` what else the armature says about
+    its bones (deform, custom shapes, constraints), which the structure mapping of control rigs reads."""
 
     name: str
     bone_names: tuple[str, ...]
@@ -21,6 +26,7 @@ class TargetRig:
     object_matrix: np.ndarray = field(default_factory=lambda: np.eye(4))
     inherit_rotation: np.ndarray | None = None
     generated: bool = False
+    links: RigLinks | None = None
 
     def __post_init__(self) -> None:
         self.bone_names = tuple(self.bone_names)

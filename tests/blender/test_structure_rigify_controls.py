@@ -1,27 +1,126 @@
-"""The generated Rigify control rig (FK controls plus ORG/DEF/MCH chains and tweak bones, all in one armature),
-every name replaced by a random string (issue 16). Its bone tree is not a body tree: the FK, IK, tweak and
-deform chains hang from mechanism bones beside one another, so the structural mapper finds no pelvis with a
-spine and two legs. What must hold today: it says so with a StructureError (it never returns a wrong mapping),
-and the rig's names still find the 'rigify' preset, which drives the FK controls. Mapping it by structure as
-its preset does (same rest segments) is not done: see /work/notes/issue-16d.md."""
+"""The generated Rigify control rig (706 bones: FK and IK controls, ORG/DEF/MCH chains, tweak bones) with every
+bone renamed to a random string in Blender (constraints and drivers follow the new names) maps by structure
+exactly as the 'rigify' preset maps the original (core/control_rig_mapping.py), `info --rig` prints it, the
+sidebar fills its table with it, and a take baked onto the renamed rig equals the bake onto the original."""
+import json
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
-from kinect_retarget.core.armature_mapping import structure_mapping_for
-from kinect_retarget.core.presets import detect_preset
-from kinect_retarget.core.structure_mapping import StructureError
-from tests.rigs.humanoid_rigs import Rig, renamed
+from kinect_retarget.core.presets import PRESETS, RIGIFY_FK_SWITCHES, build_mapping, detect_preset
+
+SAMPLES = __import__("pathlib").Path(__file__).resolve().parents[2] / "sample_takes"
 
 
-def test_rigify_control_rig_renamed_is_refused_by_structure_and_found_by_names(bpy_empty, rigify_rig_path):
+def _open(bpy, path, seed: int | None = None):
+    """The generated rig from `path`; with a seed every bone renamed. Returns (rig, {new name: old name})."""
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    obj = next(o for o in bpy.data.objects if o.type == "ARMATURE" and "upper_arm_fk.L" in o.data.bones)
+    back = {b.name: b.name for b in obj.data.bones}
+    if seed is not None:
+        rng = np.random.default_rng(seed)
+        letters = list("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789")
+        back = {}
+        for bone in list(obj.data.bones):
+            new = "".join(rng.choice(letters, 10))
+            back[new] = bone.name
+            bone.name = new
+        _fix_driver_paths(obj, {old: new for new, old in back.items()})
+    return obj, back
+
+
+def _fix_driver_paths(obj, new_name) -> None:
+    """Blender's bone rename leaves two kinds of driver paths with the old name: variables reading
+    `pose.bones["old"].scale.y` (Rigify's finger curls) and the Armature's own drivers of `bones["old"]`
+    (B-Bone eases); a renamed rig that works has the new names there too."""
+    for owner in (obj, obj.data):
+        for d in owner.animation_data.drivers if owner.animation_data else ():
+            if d.data_path.startswith('bones["') and d.data_path.split('"')[1] in new_name:
+                old = d.data_path.split('"')[1]
+                d.data_path = d.data_path.replace(f'"{old}"', f'"{new_name[old]}"', 1)
+            for target in (t for v in d.driver.variables for t in v.targets):
+                path = target.data_path
+                if path.startswith('pose.bones["') and path.split('"')[1] in new_name:
+                    old = path.split('"')[1]
+                    target.data_path = path.replace(f'"{old}"', f'"{new_name[old]}"', 1)
+
+
+@pytest.mark.parametrize("seed", [5, 16])
+def test_rigify_control_rig_renamed_maps_exactly_as_its_preset(bpy_empty, rigify_rig_path, tmp_path, seed):
+    from kinect_retarget.blender.io.rig_reader import fk_switch_bones, target_rig_from_object
     bpy = bpy_empty
-    bpy.ops.wm.open_mainfile(filepath=str(rigify_rig_path))
-    rig = next(o for o in bpy.data.objects if o.type == "ARMATURE" and "upper_arm_fk.L" in o.data.bones)
-    bones = list(rig.data.bones)
-    names = [b.name for b in bones]
-    plain = Rig(names, np.array([names.index(b.parent.name) if b.parent else -1 for b in bones]),
-                np.array([b.head_local for b in bones]), np.array([b.tail_local for b in bones]))
-    assert detect_preset(names) == "rigify"
-    anon, _ = renamed(plain, 5)
-    with pytest.raises(StructureError, match="no pelvis|no chest"):
-        structure_mapping_for(anon.names, anon.parents, anon.heads, anon.tails)
+    obj, back = _open(bpy, rigify_rig_path, seed)
+    assert len(back) == 706 and not set(back) & set(back.values())
+    rig = target_rig_from_object(obj)
+    with pytest.raises(ValueError):
+        detect_preset(rig.bone_names)   # no preset knows these names
+    used, mapping = build_mapping("auto", rig.bone_names, None, rig)
+    assert used == "structure"
+    assert {back[b]: j for b, j in mapping.items()} == PRESETS["rigify"]
+    # the bake switches the same limbs to FK, found from the rig's drivers
+    assert sorted(back[b] for b in fk_switch_bones(obj)) == sorted(RIGIFY_FK_SWITCHES)
+    if seed == 16:  # `info --rig` prints it (a second Blender process: once)
+        path = tmp_path / "renamed.blend"
+        bpy.ops.wm.save_as_mainfile(filepath=str(path))
+        r = subprocess.run([sys.executable, "-m", "kinect_retarget", "info", "--rig", str(path), "--armature",
+                            obj.name, "--json"],
+                           capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr
+        info = json.loads(r.stdout.strip().splitlines()[-1])
+        assert info["preset"] == "structure" and info["bones"] == 706
+        assert {back[b]: j for b, j in info["mapping"].items()} == PRESETS["rigify"]
+        torso = next(b for b, o in back.items() if o == "torso")
+        assert info["found"]["HipCenter"].startswith(torso)
+        assert any("control rig" in n for n in info["notes"])
+
+
+def test_sidebar_fills_the_table_of_the_renamed_control_rig(registered, rigify_rig_path):
+    bpy = registered
+    obj, back = _open(bpy, rigify_rig_path, 7)
+    s = bpy.context.scene.kinect_retarget
+    s.target = obj
+    assert bpy.ops.kinect_retarget.mapping_from_preset() == {"FINISHED"}
+    assert {back[row.bone]: row.joint for row in s.mapping if row.enabled} == PRESETS["rigify"]
+
+
+def _bake(bpy, path, seed, take):
+    """Bake `take` with the default options (preset auto); the keys by original bone name and Blender's
+    evaluation of every deform bone at a few frames."""
+    from kinect_retarget.blender.bake_take import bake_take
+    from kinect_retarget.core.pipeline import RetargetSettings
+    obj, back = _open(bpy, path, seed)
+    res = bake_take(obj, take, preset="auto", settings=RetargetSettings(filter="none", fps=take.rate))
+    keys = {back[b]: res.motion.quats[:, k] for k, b in enumerate(res.motion.bone_names)}
+    from bpy_extras import anim_utils
+    switches = {}
+    ad = obj.animation_data
+    for fc in anim_utils.action_get_channelbag_for_slot(ad.action, ad.action_slot).fcurves:
+        if fc.data_path.endswith('["IK_FK"]'):
+            bone = fc.data_path.split('"')[1]
+            switches[back[bone]] = fc.keyframe_points[0].co[1]
+    deform = sorted(back[b.name] for b in obj.data.bones if b.use_deform)
+    posed = []
+    for f in (res.frame_range[0], sum(res.frame_range) // 2, res.frame_range[1]):
+        bpy.context.scene.frame_set(f)
+        pose = {back[pb.name]: np.array(pb.matrix) for pb in obj.pose.bones}
+        posed.append(np.array([pose[n] for n in deform]))
+    return res.preset, keys, switches, deform, np.array(posed)
+
+
+def test_bake_onto_the_renamed_rig_equals_the_bake_onto_the_original(bpy_empty, rigify_rig_path):
+    from kinect_retarget.core.quat import angle_between, from_matrix
+    from kinect_retarget.takes import load_take
+    take = load_take(SAMPLES / "kinect_v1_cmu_131_03_hop.krtake").slice(slice(0, 40))
+    preset, keys, switches, deform, posed = _bake(bpy_empty, rigify_rig_path, None, take)
+    preset2, keys2, switches2, deform2, posed2 = _bake(bpy_empty, rigify_rig_path, 11, take)
+    assert (preset, preset2) == ("rigify", "structure")
+    assert set(keys2) == set(keys) and switches2 == switches and len(switches) == 4 and deform2 == deform
+    worst_key = max(float(np.degrees(angle_between(keys[b], keys2[b])).max()) for b in keys)
+    assert worst_key < 1e-4, worst_key
+    rot = lambda m: from_matrix(m[..., :3, :3] / np.linalg.norm(m[..., :3, :3], axis=-2, keepdims=True))  # noqa: E731
+    worst_deform = float(np.degrees(angle_between(rot(posed), rot(posed2))).max())
+    assert worst_deform < 1e-4, worst_deform
+    assert np.abs(posed[..., :3, 3] - posed2[..., :3, 3]).max() < 1e-6
+    print(f"renamed vs original bake: keys {worst_key:.2e} deg, {len(deform)} deform bones {worst_deform:.2e} deg")

@@ -1,7 +1,7 @@
 """`info --rig RIG.blend`: which bone of an armature drives which Kinect joint, and how it was found."""
 from __future__ import annotations
 
-from ...core.armature_mapping import structure_mapping_for
+from ...core.control_rig_mapping import map_armature
 from ...core.presets import STRUCTURE, build_mapping
 from .rig_reader import target_rig_from_object
 
@@ -17,6 +17,6 @@ def rig_mapping_summary(rig_path: str, armature: str | None = None, preset: str 
     out = {"file": rig_path, "armature": obj.name, "bones": len(rig.bone_names), "preset": used,
            "mapping": {b: j for b, j in mapping.items() if rig.has(b)}}
     if used == STRUCTURE:
-        found = structure_mapping_for(rig.bone_names, rig.parents, rig.heads, rig.tails)
+        found = map_armature(rig.bone_names, rig.parents, rig.heads, rig.tails, rig.links)
         out["found"], out["notes"] = found.joints, found.notes
     return out

@@ -3,9 +3,11 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
+from bpy.utils import escape_identifier
 
 from ...core.presets import RIGIFY_FK_SWITCHES
 from ...core.target_rig import TargetRig
+from .rig_links import rig_links_from_object
 
 GENERATED_TAG = "kinect_retarget_generated"
 
@@ -30,13 +32,21 @@ def target_rig_from_object(obj: bpy.types.Object) -> TargetRig:
     inherit = np.array([b.use_inherit_rotation for b in bones], dtype=bool)
     world = np.array(obj.matrix_world, dtype=np.float64)
     return TargetRig(obj.name, tuple(names), parents, rest, lengths.astype(np.float64), world, inherit,
-                     generated=bool(obj.get(GENERATED_TAG, False)))
+                     generated=bool(obj.get(GENERATED_TAG, False)), links=rig_links_from_object(obj))
 
 
 def fk_switch_bones(obj: bpy.types.Object) -> list[str]:
-    """The Rigify FK/IK switch bones this rig has (RIGIFY_FK_SWITCHES with an 'IK_FK' property)."""
+    """The Rigify FK/IK switch bones this rig has: RIGIFY_FK_SWITCHES with an 'IK_FK' property, or, when the
+    bones have other names, every pose bone whose 'IK_FK' property a driver of a constraint's influence reads."""
     pose_bones = obj.pose.bones
-    return [name for name in RIGIFY_FK_SWITCHES if name in pose_bones and "IK_FK" in pose_bones[name]]
+    named = [name for name in RIGIFY_FK_SWITCHES if name in pose_bones and "IK_FK" in pose_bones[name]]
+    ad = obj.animation_data
+    if named or ad is None:
+        return named
+    read = {t.data_path for d in ad.drivers if ".constraints[" in d.data_path and d.data_path.endswith(".influence")
+            for v in d.driver.variables for t in v.targets if t.id == obj}
+    return [pb.name for pb in pose_bones if "IK_FK" in pb and f'pose.bones["{escape_identifier(pb.name)}"]["IK_FK"]'
+            in read]
 
 
 def constrained_bones(obj: bpy.types.Object) -> set[str]:
