@@ -124,3 +124,23 @@ def test_bake_onto_the_renamed_rig_equals_the_bake_onto_the_original(bpy_empty, 
     assert worst_deform < 1e-4, worst_deform
     assert np.abs(posed[..., :3, 3] - posed2[..., :3, 3]).max() < 1e-6
     print(f"renamed vs original bake: keys {worst_key:.2e} deg, {len(deform)} deform bones {worst_deform:.2e} deg")
+
+
+def test_numpy_fixture_is_the_generated_rig(bpy_empty, rigify_rig_path):
+    """tests/data/rigs/rigify_generated.json (the numpy tests' copy of this rig) is what Blender generates;
+    KR_WRITE_RIGIFY_FIXTURE=1 writes it anew."""
+    import os
+
+    from kinect_retarget.blender.io.rig_reader import target_rig_from_object
+    from tests.rigs.control_rigs import RIGIFY_FIXTURE, rig_record
+    obj, _ = _open(bpy_empty, rigify_rig_path)
+    rig = target_rig_from_object(obj)
+    record = rig_record(rig.bone_names, rig.parents, rig.heads, rig.tails, rig.links)
+    if os.environ.get("KR_WRITE_RIGIFY_FIXTURE"):
+        RIGIFY_FIXTURE.parent.mkdir(parents=True, exist_ok=True)
+        RIGIFY_FIXTURE.write_text(json.dumps(record, separators=(",", ":")) + "\n", encoding="utf-8")
+    stored = json.loads(RIGIFY_FIXTURE.read_text(encoding="utf-8"))
+    for key in ("names", "parents", "deform", "shaped", "constraints"):
+        assert stored[key] == record[key], key
+    for key in ("heads", "tails"):
+        assert np.abs(np.array(stored[key]) - np.array(record[key])).max() < 1e-4, key
