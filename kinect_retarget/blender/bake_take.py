@@ -17,7 +17,7 @@ from ..core.kinect_rig_layout import median_segment_lengths
 from ..core.pipeline import BakedMotion, RetargetPipeline, RetargetSettings
 from ..core.presets import PRESET_INFO, STRUCTURE, build_mapping, mapping_problems
 from ..core.resample import resample_motion
-from ..core.root_motion import apply_root_motion, root_follows_by_constraints
+from ..core.root_motion import apply_root_motion, followed_root, root_follows_by_constraints
 from ..core.rotation_modes import channel_values
 from ..core.skeletons import Skeleton
 from ..core.take import Take
@@ -135,7 +135,9 @@ def bake_take(obj: bpy.types.Object, take: Take, *, preset: str = "auto",
     extra = []
     if used in ("rigify", STRUCTURE):  # Rigify's limbs switched to FK (no switch on other rigs)
         extra = [(f'pose.bones["{escape_identifier(b)}"]["IK_FK"]', b, np.ones(1)) for b in fk_switch_bones(obj)]
-    root_named = options.root_bone or PRESET_INFO.get(used, {}).get("root_motion_bone")  # Mannequin's, Rigify's root
+    # the root: named, the preset's (Mannequin's, Rigify's root), or the one a renamed Rigify's hips follow
+    root_named = options.root_bone or PRESET_INFO.get(used, {}).get("root_motion_bone") or (
+        followed_root(pipeline.rig, motion.root_bone) if used == STRUCTURE else None)
     root_note = ""
     if options.root_motion and root_follows_by_constraints(pipeline.rig, motion, root_named):
         # Rigify: the hips follow the root by constraints; once verified, the root joins the constrained solve,

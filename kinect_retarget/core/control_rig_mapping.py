@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .armature_mapping import ArmatureMapping, structure_mapping_for
+from .structure_mapping import StructureError
 
 COINCIDE = 1e-3        # points within this fraction of the rig's size are one point (generated copies: exact)
 DRIVEN_SHARE = 0.5     # a control rig: at least this share of its deform bones follow others by constraints
@@ -63,7 +64,13 @@ def is_control_rig(parents, links: RigLinks | None) -> bool:
 def map_armature(bone_names, parents, heads, tails, links: RigLinks | None = None) -> ArmatureMapping:
     """The structure mapping of any armature: control rigs through their deform bones, others directly."""
     if links is not None and is_control_rig(parents, links):
-        return control_rig_mapping(bone_names, parents, heads, tails, links)
+        try:
+            return control_rig_mapping(bone_names, parents, heads, tails, links)
+        except StructureError as exc:  # its deform bones are no body: its own tree may still be one
+            try:
+                return structure_mapping_for(bone_names, parents, heads, tails)
+            except StructureError:
+                raise exc from None
     return structure_mapping_for(bone_names, parents, heads, tails)
 
 
@@ -217,4 +224,7 @@ def control_rig_mapping(bone_names, parents, heads, tails, links: RigLinks) -> A
                "moves the chest but not the pelvis; nothing else moving it does" if joint == "ShoulderCenter"
                else "control spanning the deform bone")
         how[joint] = f"{bone_names[picks[0]]} ({why}; deform bone {bone_names[bone_of[joint]]})"
+    left = [j for j in bone_of if j not in order]  # Spine, Hip: the rig moves them from the torso controls
+    if left:
+        notes.append(f"left to the torso controls, which the rig's constraints carry them with: {', '.join(left)}")
     return ArmatureMapping(out, how, notes)

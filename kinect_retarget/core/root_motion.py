@@ -42,6 +42,24 @@ def find_root_bone(rig: TargetRig, hips: int, named: str | None = None, constrai
     return above[-1]
 
 
+def followed_root(rig: TargetRig, hips: str | None) -> str | None:
+    """The root a control rig's hips follow by constraints, found without names (rig.links): from the hips'
+    top ancestor through Armature, Child Of or full Copy Transforms constraints reading one bone (Rigify: torso
+    -> MCH-torso.parent -> its Armature constraint -> root). None when there is no such bone."""
+    if rig.links is None or hips is None or not rig.has(hips):
+        return None
+    b, seen = rig.index(hips), set()
+    while b not in seen:
+        seen.add(b)
+        b = ([b] + rig.ancestors(b))[-1]
+        follows = [c.targets[0] for c in rig.links.constraints[b] if len(c.targets) == 1 and c.influence >= 0.999
+                   and c.kind in ("ARMATURE", "CHILD_OF", "COPY_TRANSFORMS")]
+        if not follows:
+            return rig.bone_names[b] if len(seen) > 1 else None
+        b = follows[0]
+    return None
+
+
 def _basis(quats: np.ndarray, location: np.ndarray) -> np.ndarray:
     m = np.broadcast_to(np.eye(4), quats.shape[:-1] + (4, 4)).copy()
     m[..., :3, :3] = to_matrix(quats)

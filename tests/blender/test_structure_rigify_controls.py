@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from kinect_retarget.core.presets import PRESETS, RIGIFY_FK_SWITCHES, build_mapping, detect_preset
+from tests.rigs.control_rigs import rename_bones
 
 SAMPLES = __import__("pathlib").Path(__file__).resolve().parents[2] / "sample_takes"
 
@@ -18,33 +19,7 @@ def _open(bpy, path, seed: int | None = None):
     """The generated rig from `path`; with a seed every bone renamed. Returns (rig, {new name: old name})."""
     bpy.ops.wm.open_mainfile(filepath=str(path))
     obj = next(o for o in bpy.data.objects if o.type == "ARMATURE" and "upper_arm_fk.L" in o.data.bones)
-    back = {b.name: b.name for b in obj.data.bones}
-    if seed is not None:
-        rng = np.random.default_rng(seed)
-        letters = list("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789")
-        back = {}
-        for bone in list(obj.data.bones):
-            new = "".join(rng.choice(letters, 10))
-            back[new] = bone.name
-            bone.name = new
-        _fix_driver_paths(obj, {old: new for new, old in back.items()})
-    return obj, back
-
-
-def _fix_driver_paths(obj, new_name) -> None:
-    """Blender's bone rename leaves two kinds of driver paths with the old name: variables reading
-    `pose.bones["old"].scale.y` (Rigify's finger curls) and the Armature's own drivers of `bones["old"]`
-    (B-Bone eases); a renamed rig that works has the new names there too."""
-    for owner in (obj, obj.data):
-        for d in owner.animation_data.drivers if owner.animation_data else ():
-            if d.data_path.startswith('bones["') and d.data_path.split('"')[1] in new_name:
-                old = d.data_path.split('"')[1]
-                d.data_path = d.data_path.replace(f'"{old}"', f'"{new_name[old]}"', 1)
-            for target in (t for v in d.driver.variables for t in v.targets):
-                path = target.data_path
-                if path.startswith('pose.bones["') and path.split('"')[1] in new_name:
-                    old = path.split('"')[1]
-                    target.data_path = path.replace(f'"{old}"', f'"{new_name[old]}"', 1)
+    return obj, (rename_bones(obj, seed) if seed is not None else {b.name: b.name for b in obj.data.bones})
 
 
 @pytest.mark.parametrize("seed", [5, 16])
@@ -85,13 +60,14 @@ def test_sidebar_fills_the_table_of_the_renamed_control_rig(registered, rigify_r
     assert {back[row.bone]: row.joint for row in s.mapping if row.enabled} == PRESETS["rigify"]
 
 
-def _bake(bpy, path, seed, take):
-    """Bake `take` with the default options (preset auto); the keys by original bone name and Blender's
+def _bake(bpy, path, seed, take, options=None):
+    """Bake `take` (preset auto; default options unless given); the keys by original bone name and Blender's
     evaluation of every deform bone at a few frames."""
     from kinect_retarget.blender.bake_take import bake_take
     from kinect_retarget.core.pipeline import RetargetSettings
     obj, back = _open(bpy, path, seed)
-    res = bake_take(obj, take, preset="auto", settings=RetargetSettings(filter="none", fps=take.rate))
+    res = bake_take(obj, take, preset="auto", settings=RetargetSettings(filter="none", fps=take.rate),
+                    options=options)
     keys = {back[b]: res.motion.quats[:, k] for k, b in enumerate(res.motion.bone_names)}
     from bpy_extras import anim_utils
     switches = {}
@@ -100,7 +76,7 @@ def _bake(bpy, path, seed, take):
         if fc.data_path.endswith('["IK_FK"]'):
             bone = fc.data_path.split('"')[1]
             switches[back[bone]] = fc.keyframe_points[0].co[1]
-    deform = sorted(back[b.name] for b in obj.data.bones if b.use_deform)
+    deform = sorted(back[b.name] for b in obj.data.bones if b.use_deform or back[b.name] == "root")
     posed = []
     for f in (res.frame_range[0], sum(res.frame_range) // 2, res.frame_range[1]):
         bpy.context.scene.frame_set(f)
@@ -109,12 +85,18 @@ def _bake(bpy, path, seed, take):
     return res.preset, keys, switches, deform, np.array(posed)
 
 
-def test_bake_onto_the_renamed_rig_equals_the_bake_onto_the_original(bpy_empty, rigify_rig_path):
+@pytest.mark.parametrize("root_motion", [False, True], ids=["default", "root-motion"])
+def test_bake_onto_the_renamed_rig_equals_the_bake_onto_the_original(bpy_empty, rigify_rig_path, root_motion):
+    """Default options (feet locked), and with root motion: the renamed rig's root is found as the bone its
+    torso follows by constraints, and carries the same travel as the preset's `root`."""
+    from kinect_retarget.core.bake_options import BakeOptions
     from kinect_retarget.core.quat import angle_between, from_matrix
     from kinect_retarget.takes import load_take
     take = load_take(SAMPLES / "kinect_v1_cmu_131_03_hop.krtake").slice(slice(0, 40))
-    preset, keys, switches, deform, posed = _bake(bpy_empty, rigify_rig_path, None, take)
-    preset2, keys2, switches2, deform2, posed2 = _bake(bpy_empty, rigify_rig_path, 11, take)
+    options = BakeOptions(root_motion=root_motion)
+    preset, keys, switches, deform, posed = _bake(bpy_empty, rigify_rig_path, None, take, options)
+    preset2, keys2, switches2, deform2, posed2 = _bake(bpy_empty, rigify_rig_path, 11, take, options)
+    assert ("root" in keys) == root_motion
     assert (preset, preset2) == ("rigify", "structure")
     assert set(keys2) == set(keys) and switches2 == switches and len(switches) == 4 and deform2 == deform
     worst_key = max(float(np.degrees(angle_between(keys[b], keys2[b])).max()) for b in keys)
@@ -123,7 +105,7 @@ def test_bake_onto_the_renamed_rig_equals_the_bake_onto_the_original(bpy_empty, 
     worst_deform = float(np.degrees(angle_between(rot(posed), rot(posed2))).max())
     assert worst_deform < 1e-4, worst_deform
     assert np.abs(posed[..., :3, 3] - posed2[..., :3, 3]).max() < 1e-6
-    print(f"renamed vs original bake: keys {worst_key:.2e} deg, {len(deform)} deform bones {worst_deform:.2e} deg")
+    print(f"renamed vs original bake: keys {worst_key:.2e} deg, {len(deform)} deform bones and root {worst_deform:.2e} deg")
 
 
 def test_numpy_fixture_is_the_generated_rig(bpy_empty, rigify_rig_path):

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from kinect_retarget.core.armature_mapping import structure_mapping_for
-from kinect_retarget.core.control_rig_mapping import (Constraint, RigLinks, deform_parents, is_control_rig,
-                                                       map_armature)
+from kinect_retarget.core.control_rig_mapping import Constraint, RigLinks, deform_parents, is_control_rig, map_armature
 from kinect_retarget.core.presets import PRESETS, build_mapping
+from kinect_retarget.core.root_motion import followed_root
 from kinect_retarget.core.structure_mapping import StructureError
 from tests.rigs.control_rigs import reordered, rigify_controls
 from tests.rigs.humanoid_rigs import build, renamed
@@ -81,3 +81,15 @@ def test_plain_rigs_do_not_take_the_control_rig_route(family):
     assert not is_control_rig(rig.parents, helpers)
     expect = structure_mapping_for(rig.names, rig.parents, rig.heads, rig.tails).mapping
     assert map_armature(rig.names, rig.parents, rig.heads, rig.tails, plain).mapping == expect
+
+
+def test_root_motion_bone_of_the_renamed_rig_is_the_root_its_torso_follows():
+    """Rigify's torso hangs from a parentless bone whose Armature constraint reads `root`: that is the bone
+    root motion goes onto (the preset names it; renamed, it is found through the constraint)."""
+    rig, links = rigify_controls()
+    anon, back = renamed(rig, 4)
+    target = anon.target()
+    target.links = links
+    torso = next(b for b, o in back.items() if o == "torso")
+    assert back[followed_root(target, torso)] == "root"
+    assert followed_root(anon.target(), torso) is None   # without links: nothing to follow

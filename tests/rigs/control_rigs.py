@@ -49,3 +49,35 @@ def reordered(rig: Rig, links: RigLinks, seed: int) -> tuple[Rig, RigLinks]:
     cons = tuple(tuple(Constraint(c.kind, tuple(remap(t) for t in c.targets), c.influence, c.chain)
                        for c in links.constraints[b]) for b in order)
     return out, RigLinks(links.deform[order], links.shaped[order], cons)
+
+
+def rename_bones(obj, seed: int) -> dict[str, str]:
+    """Rename every bone of a Blender armature object to a seeded random string (constraints and most driver
+    paths follow by themselves); returns {new name: old name}."""
+    rng = np.random.default_rng(seed)
+    letters = list("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789")
+    back = {}
+    for bone in list(obj.data.bones):
+        new = "".join(rng.choice(letters, 10))
+        back[new] = bone.name
+        bone.name = new
+    _fix_driver_paths(obj, {old: new for new, old in back.items()})
+    return back
+
+
+def _renamed_path(path: str, prefix: str, new_name: dict[str, str]) -> str:
+    if path.startswith(prefix + '["') and path.split('"')[1] in new_name:
+        old = path.split('"')[1]
+        return path.replace(f'"{old}"', f'"{new_name[old]}"', 1)
+    return path
+
+
+def _fix_driver_paths(obj, new_name: dict[str, str]) -> None:
+    """Blender's bone rename leaves two kinds of driver paths with the old name: variables reading
+    `pose.bones["old"].scale.y` (Rigify's finger curls) and the Armature's own drivers of `bones["old"]`
+    (B-Bone eases); a renamed rig that works has the new names there too."""
+    for owner in (obj, obj.data):
+        for d in owner.animation_data.drivers if owner.animation_data else ():
+            d.data_path = _renamed_path(d.data_path, "bones", new_name)
+            for target in (t for v in d.driver.variables for t in v.targets):
+                target.data_path = _renamed_path(target.data_path, "pose.bones", new_name)
