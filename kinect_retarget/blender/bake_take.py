@@ -78,7 +78,8 @@ def _reduce(obj, motion: BakedMotion, options: BakeOptions) -> Reduction | None:
         mode = pose_bones[bone].rotation_mode
         rotations.append((channel_values(motion.quats[:, k], mode)[1], mode))
     location = motion.root_location if motion.root_bone is not None else None
-    return reduce_keys(motion.frames, rotations, location, options.tolerance_deg, options.tolerance_mm)
+    return reduce_keys(motion.frames, rotations, location, options.tolerance_deg, options.tolerance_mm,
+                       motion.extras.get("locations"))
 
 
 def _update_scene(scene: bpy.types.Scene, rate: float, first: int, last: int, options: BakeOptions) -> str:

@@ -7,8 +7,10 @@ its height over the floor in the rig's rest pose. First the whole body moves up 
 ankles stand at that height (a vertical shift of the hips turns no bone). The leg reaches each new ankle by
 two-bone IK: the hip-ankle line turns the shortest way onto it, the bend plane turns with the line (the knee
 stays in it, no twist about the leg), the knee takes the angle that fits the distance; the foot keeps its
-orientation in the armature. Only the three
-leg bones' keys change, and only on frames that need it. Pure numpy; the rig's rest matrices are not touched.
+orientation in the armature. Last, where a foot points down more steeply than the rest foot, its tip and toes
+would dip under the floor: the foot pitches up about the ankle just enough, eased in and out (toe_floor.py).
+Only the three leg bones' keys change, and only on frames that need it. Pure numpy; the rig's rest matrices are
+not touched.
 """
 from __future__ import annotations
 
@@ -16,9 +18,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .foot_contacts import detect_contacts, intervals, pin_weights
+from .foot_contacts import RAMP_S, detect_contacts, intervals, pin_weights
 from .quat import conjugate, from_matrix, make_continuous, mul, normalize, to_matrix
 from .target_rig import evaluate_pose
+from .toe_floor import (axis_angle_quats, eased, needed_pitch, pitch_axes, pitch_room, rest_pitch_axis, tip_bones,
+                        tips)
 
 FEET_MODES = ("lock", "floor", "off")
 PIN_HEIGHT_PERCENTILE = 90
@@ -32,11 +36,15 @@ class LegReport:
     contact_frames: int
     slide_before_cm: tuple[float, float]   # median, p95 horizontal distance from the contact's place
     slide_after_cm: tuple[float, float]
-    below_floor_before_cm: float           # deepest ankle or toe below its floor limit
+    below_floor_before_cm: float           # deepest ankle below its rest height over the floor
     below_floor_after_cm: float
     frames_changed: int
     changed: np.ndarray = field(default_factory=lambda: np.zeros(0, bool), repr=False)  # (F,) keys edited
     contact: np.ndarray = field(default_factory=lambda: np.zeros(0, bool), repr=False)  # (F,) planted
+    toe_below_before_cm: float = 0.0       # deepest foot tip or toe tip below the floor
+    toe_below_after_cm: float = 0.0
+    pitched: np.ndarray = field(default_factory=lambda: np.zeros(0, bool), repr=False)  # (F,) foot pitched up
+    toe_frames: int = 0                    # how many (to keep the toes on the floor)
 
 
 @dataclass
@@ -50,6 +58,7 @@ class FeetReport:
             return "feet: off" if self.mode == "off" else "feet: no leg mapped"
         parts = [f"{g.side} {g.contacts} contacts, slide p95 {g.slide_before_cm[1]:.1f} -> {g.slide_after_cm[1]:.1f}"
                  f" cm, below floor {g.below_floor_before_cm:.1f} -> {g.below_floor_after_cm:.1f} cm"
+                 f" (toes {g.toe_below_before_cm:.1f} -> {g.toe_below_after_cm:.1f} cm)"
                  for g in self.legs]
         return f"feet ({self.mode}, body raised {self.height_shift_cm:.1f} cm): " + "; ".join(parts)
 
@@ -116,6 +125,9 @@ class FootLock:
             thigh, shin, foot = (by_joint.get(j + side) for j in ("Knee", "Ankle", "Foot"))
             if thigh is not None and shin is not None:
                 self.legs[side] = (thigh, shin, foot)
+        self.tips = {side: tip_bones(self.rig, foot.index) for side, (_, _, foot) in self.legs.items() if foot}
+        self.across = {side: rest_pitch_axis(self.rig, foot.index, self.up)
+                       for side, (_, _, foot) in self.legs.items() if foot}
 
     def _local(self, motion, desired: np.ndarray, name: str) -> np.ndarray:
         """Pose-bone quaternions of bone `name` from the desired armature-space rotations (the solver's eq. 12)."""
@@ -150,12 +162,47 @@ class FootLock:
             report.legs.append(leg)
             done.append((leg, contact, shin, foot))
         motion.quats = make_continuous(motion.quats, axis=0)
+        if any(foot is not None for *_, foot in done):
+            legged = evaluate_pose(self.rig, idx, motion.quats, root, motion.root_location)
+            for leg, _, _, foot in done:
+                if foot is not None:
+                    self._toes(motion, desired, legged, leg, foot, rate)
+            motion.quats = make_continuous(motion.quats, axis=0)
         after = evaluate_pose(self.rig, idx, motion.quats, root, motion.root_location)  # measured, not assumed
         for leg, contact, shin, foot in done:
             ankle, toe, limit = self._ankle(after, shin, foot)
             leg.slide_after_cm = _stats_cm(_slide(ankle, contact, self.up))
             leg.below_floor_after_cm = 100 * self._below(ankle, toe, limit)
+            if foot is not None:
+                leg.toe_below_after_cm = 100 * self._toe_below(after, leg.side)
         return report
+
+    def _toe_below(self, posed, side, shift: float = 0.0) -> float:
+        """Deepest tip of the foot or its toes below the floor (m), 0 when none is; `shift` is taken off the
+        heights (the body's vertical shift, to measure the bake as it was before it)."""
+        return float(max(0.0, (self.floor + shift - tips(self.rig, posed, self.tips[side]) @ self.up).max()))
+
+    def _toes(self, motion, desired, posed, leg, foot, rate) -> None:
+        """Pitch the foot up about its ankle where its tip or toes would be under the floor (eased)."""
+        m = posed[:, foot.index]
+        axis = pitch_axes(m, self.across[leg.side], self.up)
+        shape = (m[:, :3, 3], tips(self.rig, posed, self.tips[leg.side]), axis, self.up, self.floor)
+        need = needed_pitch(*shape)
+        if not need.any():
+            return
+        # eased in and out, but never past where a toe that was up would sink (a foot whipping round in the take)
+        angle = np.maximum(np.minimum(eased(need, max(2, int(round(RAMP_S * rate)))), pitch_room(*shape, need)), need)
+        f = np.flatnonzero(angle > 0)
+        j = motion.bone_names.index(foot.bone)
+        turn = axis_angle_quats(axis[f], angle[f])
+        desired[f, j] = mul(turn, desired[f, j])
+        # the same turn on the keyed pose as it is (a resampled bake's desired rotations only approximate it):
+        # world' = turn . world  <=>  local' = local . (world^-1 . turn . world)
+        world = from_matrix(m[f, :3, :3])
+        motion.quats[f, j] = mul(motion.quats[f, j], mul(conjugate(world), mul(turn, world)))
+        leg.changed[f] = True
+        leg.frames_changed = int(leg.changed.sum())
+        leg.pitched, leg.toe_frames = angle > 0, len(f)
 
     def _place(self, path: np.ndarray) -> np.ndarray:
         """Where a planted ankle is pinned: its mean place over the contact, at a high percentile of its heights
@@ -164,19 +211,25 @@ class FootLock:
         return place + (np.percentile(path @ self.up, PIN_HEIGHT_PERCENTILE) - place @ self.up) * self.up
 
     def _stand(self, motion, posed, root, rate) -> float:
-        """Raise (or lower) the whole body so planted ankles stand at their rest height over the floor: one
-        vertical shift of the hips for the take (the median depth over both feet's contacts), which turns no
-        bone. The rig's legs, in the performer's stance, may reach lower than in its own rest pose (MakeHuman's
-        hip bones turned to a Kinect hip line). Returns the shift (m); posed is shifted in place."""
+        """Raise (or lower) the whole body so planted feet stand on the floor: ankles at their rest height
+        over it, and toes not under it (a foot planted pointing down, as Kinect's are, stands on its toes, not
+        on an ankle at the rig's rest height). One vertical shift of the hips for the take (the median depth
+        over both feet's contacts), which turns no bone. The rig's legs, in the performer's stance, may reach
+        lower than in its own rest pose (MakeHuman's hip bones turned to a Kinect hip line). Returns the shift
+        (m); posed is shifted in place."""
         if root is None or not len(motion.frames):
             return 0.0
         depths = []
-        for thigh, shin, foot in self.legs.values():
+        for side, (thigh, shin, foot) in self.legs.items():
             if thigh.bone in motion.bone_names and shin.bone in motion.bone_names:
                 foot = foot if foot is not None and foot.bone in motion.bone_names else None
                 ankle, _, limit = self._ankle(posed, shin, foot)
                 contact = detect_contacts(ankle, self.up, self._leg_length(thigh, shin, foot), rate)
-                depths.append(limit - ankle[contact] @ self.up)
+                depth = limit - ankle[contact] @ self.up
+                if foot is not None:
+                    toes = tips(self.rig, posed[contact], self.tips[side]) @ self.up
+                    depth = np.maximum(depth, self.floor - toes.min(axis=1, initial=np.inf))
+                depths.append(depth)
         depth = np.concatenate(depths) if depths else np.zeros(0)
         if not depth.size:
             return 0.0
@@ -202,8 +255,7 @@ class FootLock:
         return ankle, toe, float(rig.rest[foot.index, :3, 3] @ self.up)
 
     def _below(self, ankle, toe, limit) -> float:
-        """Deepest ankle below its rest height over the floor (m), 0 when none is. (The toes follow the foot's
-        direction in the take; a take whose feet point down more steeply than the rig's rest feet dips them.)"""
+        """Deepest ankle below its rest height over the floor (m), 0 when none is (the toes: _toe_below)."""
         return float(max(0.0, (limit - ankle @ self.up).max()))
 
     def _leg(self, motion, desired, posed, side, thigh, shin, foot, mode, rate) -> tuple[LegReport, np.ndarray]:
@@ -222,9 +274,12 @@ class FootLock:
         target += lift[:, None] * up
         change = np.linalg.norm(target - ankle, axis=-1) > 1e-9
         self._ik(motion, desired, posed, thigh, shin, foot, hip, knee, ankle, target, change)
-        return LegReport(side, len(intervals(contact)), int(contact.sum()), _stats_cm(_slide(ankle, contact, up)),
-                         (0.0, 0.0), 100 * self._below(ankle - self.shift * up, toe, limit), 0.0,
-                         int(change.sum()), change, contact), contact
+        report = LegReport(side, len(intervals(contact)), int(contact.sum()), _stats_cm(_slide(ankle, contact, up)),
+                           (0.0, 0.0), 100 * self._below(ankle - self.shift * up, toe, limit), 0.0,
+                           int(change.sum()), change, contact)
+        if foot is not None:  # as baked, before the body's shift
+            report.toe_below_before_cm = 100 * self._toe_below(posed, side, self.shift)
+        return report, contact
 
     def _ik(self, motion, desired, posed, thigh, shin, foot, hip, knee, ankle, target, change) -> None:
         if not change.any():

@@ -7,7 +7,7 @@ a rotation with the original one. Douglas-Peucker: the key with the largest erro
 span is within tolerance, so the first and last keys always stay."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -82,18 +82,21 @@ def reduce_track(frames: np.ndarray, values: np.ndarray, error, tolerance: float
 
 @dataclass
 class Reduction:
-    """Kept key indices per rotation track and for the root location, keys removed, and the largest error
-    left (degrees, millimetres)."""
+    """Kept key indices per rotation track, for the root location and for each other keyed location (root
+    motion's root bone), keys removed, and the largest error left (degrees, millimetres)."""
     rotation_keys: list[np.ndarray]
     location_keys: np.ndarray | None
     removed: int
     max_deg: float
     max_mm: float
+    other_location_keys: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def reduce_keys(frames: np.ndarray, rotations: list[tuple[np.ndarray, str]], location: np.ndarray | None,
-                deg: float, mm: float) -> Reduction:
-    """rotations: per bone (channel values (N, n), rotation mode); location (N, 3) metres or None."""
+                deg: float, mm: float, other_locations: dict[str, np.ndarray] | None = None) -> Reduction:
+    """rotations: per bone (channel values (N, n), rotation mode); location (N, 3) metres or None (the root
+    bone's); other_locations: {bone: (N, 3)} other keyed locations (root motion's root bone), thinned within
+    the same `mm`."""
     frames = np.asarray(frames, dtype=np.float64)
     tol = np.radians(deg)
     kept, removed, max_deg = [], 0, 0.0
@@ -104,10 +107,15 @@ def reduce_keys(frames: np.ndarray, rotations: list[tuple[np.ndarray, str]], loc
         kept.append(idx)
         removed += (len(frames) - len(idx)) * values.shape[-1]
         max_deg = max(max_deg, np.degrees(worst))
-    loc_idx, max_mm = None, 0.0
-    if location is not None:
-        loc_idx, worst = reduce_track(frames, np.asarray(location, dtype=np.float64),
-                                      lambda o, a: np.linalg.norm(o - a, axis=-1), mm / 1000.0)
-        removed += (len(frames) - len(loc_idx)) * 3
-        max_mm = worst * 1000.0
-    return Reduction(kept, loc_idx, removed, max_deg, max_mm)
+    loc_idx, max_mm, others = None, 0.0, {}
+    tracks = ([(None, location)] if location is not None else []) + list((other_locations or {}).items())
+    for bone, values in tracks:
+        idx, worst = reduce_track(frames, np.asarray(values, dtype=np.float64),
+                                  lambda o, a: np.linalg.norm(o - a, axis=-1), mm / 1000.0)
+        removed += (len(frames) - len(idx)) * 3
+        max_mm = max(max_mm, worst * 1000.0)
+        if bone is None:
+            loc_idx = idx
+        else:
+            others[bone] = idx
+    return Reduction(kept, loc_idx, removed, max_deg, max_mm, others)

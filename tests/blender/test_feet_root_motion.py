@@ -143,3 +143,70 @@ def test_root_motion_on_rigify_keys_root_and_keeps_the_world_pose(rigify_rig_pat
     with pytest.raises(ValueError, match="do not move rigidly"):
         bake_take(obj, take, preset="rigify", settings=settings, options=BakeOptions(**opts, root_motion=True))
     bpy.ops.wm.read_factory_settings(use_empty=True)
+
+
+def test_key_reduction_thins_the_root_motion_keys_within_its_tolerance(bpy_empty):
+    """Root motion's root bone location keys go through key reduction with the same tolerance as the hips'
+    location: far fewer keys, and the root's path as Blender plays the keys back stays within 1 mm."""
+    from bpy_extras import anim_utils
+
+    from kinect_retarget.blender.bake_take import bake_take
+    bpy = bpy_empty
+    obj = _armature(bpy)
+    take = load_take(HOP)
+    settings = RetargetSettings(fps=take.rate)
+    root = obj.pose.bones.find("root")
+
+    def bake(**kw):
+        res = bake_take(obj, take, settings=settings, options=BakeOptions(feet="off", root_motion=True, **kw))
+        curves = anim_utils.animdata_get_channelbag_for_assigned_slot(obj.animation_data).fcurves
+        keys = [len(fc.keyframe_points) for fc in curves if fc.data_path == 'pose.bones["root"].location']
+        frames = np.arange(res.motion.frames[0], res.motion.frames[-1] + 1)
+        return res, keys, _world(bpy, obj, frames)[:, root, :3, 3]
+
+    full, full_keys, full_path = bake()
+    thin, thin_keys, thin_path = bake(reduce=True, tolerance_deg=0.5, tolerance_mm=1.0)
+    n = len(full.motion.frames)
+    assert full_keys == [n, n, n]
+    assert len(thin_keys) == 3 and max(thin_keys) < 0.8 * n        # the root's keys were thinned (276 -> 195)
+    assert thin.reduction is not None and set(thin.reduction.other_location_keys) == {"root"}
+    assert np.linalg.norm(full_path[-1, :2] - full_path[0, :2]) > 0.3     # the root travels
+    err = np.linalg.norm(thin_path - full_path, axis=-1).max()
+    assert err <= 1e-3 + 1e-5, err                                     # within the stated tolerance
+    assert thin.reduction.max_mm <= 1.0 + 1e-6
+
+
+def test_cli_bake_keeps_the_toes_of_feet_pointing_down_on_the_floor(bpy_empty, tmp_path):
+    """A walk whose feet point 40 degrees further down than the performer's: baked with --feet off the toes
+    go under the floor; with --feet lock and --feet floor the foot's and ball's tails stay at or above it at
+    every key, as Blender evaluates the baked file."""
+    from bpy_extras import anim_utils
+
+    from kinect_retarget.takes import krtake
+    from tests.takes.steep_feet import steep_feet
+    bpy = bpy_empty
+    _armature(bpy)
+    rig_path, take_path = tmp_path / "ue4.blend", tmp_path / "steep.krtake"
+    bpy.ops.wm.save_as_mainfile(filepath=str(rig_path))
+    krtake.write(take_path, steep_feet(load_take(SAMPLE_TAKES / "kinect_v1_cmu_131_02_walk.krtake")))
+    lowest = {}
+    for mode in ("off", "lock", "floor"):
+        out = tmp_path / f"{mode}.blend"
+        r = subprocess.run([sys.executable, "-m", "kinect_retarget", "bake", str(take_path), "--rig", str(rig_path),
+                            "--out", str(out), "--feet", mode, "--take-end", "4"],
+                           capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr
+        bpy.ops.wm.open_mainfile(filepath=str(out))
+        obj = bpy.data.objects["UE4"]
+        floor = min(min(b.head_local[2], b.tail_local[2]) for b in obj.data.bones)
+        curves = anim_utils.animdata_get_channelbag_for_assigned_slot(obj.animation_data).fcurves
+        keys = next(fc for fc in curves if fc.data_path.startswith('pose.bones["foot_l"].rotation')).keyframe_points
+        tails = []
+        for k in keys:  # at every key (between keys Blender interpolates each channel)
+            f = k.co[0]
+            bpy.context.scene.frame_set(int(f), subframe=f - int(f))
+            tails.append([(obj.matrix_world @ obj.pose.bones[b].tail)[2] for b in ("foot_l", "ball_l", "foot_r",
+                                                                                 "ball_r")])
+        lowest[mode] = float(np.min(tails) - floor)
+    assert lowest["off"] < -0.03, lowest                                    # the toes dip without the pass
+    assert lowest["lock"] >= -1e-4 and lowest["floor"] >= -1e-4, lowest  # and stay on the floor with it

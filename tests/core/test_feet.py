@@ -17,6 +17,7 @@ from kinect_retarget.takes import load_take
 from tests.conftest import SAMPLE_TAKES
 from tests.rigs.humanoid_rigs import build, makehuman_rig
 from tests.rigs.layouts import LAYOUTS
+from tests.takes.steep_feet import steep_feet
 
 UP = np.array([0.0, 0.0, 1.0])
 
@@ -46,7 +47,7 @@ def test_contacts_with_hysteresis_on_a_noisy_gait():
 
 
 def _bake(name, rig_kind):
-    take = load_take(SAMPLE_TAKES / f"{name}.krtake")
+    take = name if not isinstance(name, str) else load_take(SAMPLE_TAKES / f"{name}.krtake")
     if rig_kind == "generated":
         rig, mapping = generated_rig(take.skeleton, median_segment_lengths(take)), generated_mapping(take.skeleton)
     elif rig_kind == "makehuman":
@@ -80,6 +81,16 @@ def _turn(a, b):
     k[:, 0, 1], k[:, 0, 2], k[:, 1, 0], k[:, 1, 2], k[:, 2, 0], k[:, 2, 1] = -v[:, 2], v[:, 1], v[:, 2], -v[:, 0], \
         -v[:, 1], v[:, 0]
     return np.eye(3) + k + (k @ k) / (1 + c)[:, None, None]
+
+
+def _toes_below(rig, lock, posed, side):
+    """Deepest tail of the foot or any bone below it under the rest pose's lowest point (m), from the pose."""
+    foot = lock.legs[side][2].index
+    below = [b for b in range(len(rig.bone_names)) if b == foot or foot in rig.ancestors(b)]
+    sel = posed[:, below]
+    tails = sel[..., :3, 3] + sel[..., :3, 1] * rig.lengths[below][None, :, None]
+    floor = min(rig.heads[:, 2].min(), rig.tails[:, 2].min())
+    return float(max(0.0, floor - tails[..., 2].min()))
 
 
 def _pose(rig, motion):
@@ -121,8 +132,11 @@ def test_locked_feet_stay_put_above_the_floor_and_nothing_else_moves(name, rig_k
         leg_bones |= set(below)
         unchanged = ~leg.changed
         np.testing.assert_allclose(p1[unchanged][:, below, :3, :3], p0[unchanged][:, below, :3, :3], atol=1e-9)
-        # the foot keeps its orientation in the armature where the leg was bent for it
-        np.testing.assert_allclose(p1[:, foot.index, :3, :3], p0[:, foot.index, :3, :3], atol=1e-9)
+        # the foot keeps its orientation in the armature where the leg was bent for it (and was not pitched up
+        # to keep its toes on the floor)
+        flat = ~leg.pitched if leg.pitched.size else slice(None)
+        np.testing.assert_allclose(p1[flat, foot.index, :3, :3], p0[flat, foot.index, :3, :3], atol=1e-9)
+        assert leg.toe_below_after_cm < 1e-6 and _toes_below(rig, lock, p1, leg.side) < 1e-8
     others = [b for b in range(len(rig.bone_names)) if b not in leg_bones]
     np.testing.assert_allclose(p1[:, others, :3, :3], p0[:, others, :3, :3], atol=1e-9)  # directions
     hips = rig.index(before.root_bone)  # the body moved up or down as one; the bones above the hips stay
@@ -143,3 +157,44 @@ def test_floor_mode_only_lifts_and_off_changes_nothing():
     assert all(leg.below_floor_after_cm < 1e-6 for leg in report.legs)
     with pytest.raises(ValueError, match="feet mode"):
         FootLock(pipe.retargeter).apply(floor, "glue", take.rate)
+
+
+@pytest.mark.parametrize("rig_kind", ["generated", "ue4", "makehuman"])
+@pytest.mark.parametrize("mode", ["lock", "floor"])
+def test_feet_pointing_down_keep_their_toes_on_the_floor(rig_kind, mode):
+    """Feet turned 40 degrees further down than the performer's dip the foot tip (and a toe bone's tip) under
+    the floor in the plain bake; the pass pitches each foot up about its ankle just enough, eased in and out,
+    and turns nothing else."""
+    take = steep_feet(load_take(SAMPLE_TAKES / "kinect_v1_cmu_131_02_walk.krtake"))
+    _, rig, pipe, before = _bake(take, rig_kind)
+    after = copy.deepcopy(before)
+    lock = FootLock(pipe.retargeter)
+    report = lock.apply(after, mode, take.rate)
+    p0, p1 = _pose(rig, before), _pose(rig, after)
+    for leg in report.legs:
+        thigh, shin, foot = lock.legs[leg.side]
+        assert leg.toe_below_before_cm > 2.0 and _toes_below(rig, lock, p0, leg.side) > 0.02  # the test can fail
+        assert leg.toe_below_after_cm < 1e-6 and _toes_below(rig, lock, p1, leg.side) < 1e-8
+        assert leg.below_floor_after_cm < 1e-6
+        assert 0 < leg.toe_frames < len(after.frames) and leg.changed[leg.pitched].all()
+        # eased: a pitched stretch starts and ends small, never at full angle
+        pitch = _angle(p0[:, foot.index, :3, :3], p1[:, foot.index, :3, :3]) * leg.pitched
+        start = np.flatnonzero(leg.pitched[1:] & ~leg.pitched[:-1]) + 1
+        end = np.flatnonzero(leg.pitched[:-1] & ~leg.pitched[1:])
+        assert pitch[start].max(initial=0) < 0.4 * pitch.max() and pitch[end].max(initial=0) < 0.4 * pitch.max()
+        # the pitch turns the foot about its ankle: where the leg itself was not bent, the ankle stays put
+        # (up to the body's one vertical shift)
+        legs_bent = np.abs(p1[:, [thigh.index, shin.index], :3, :3] - p0[:, [thigh.index, shin.index], :3, :3]
+                           ).max(axis=(1, 2, 3)) > 1e-9
+        only = leg.pitched & ~legs_bent
+        assert only.any()
+        np.testing.assert_allclose(p1[only, foot.index, :3, 3],
+                                   p0[only, foot.index, :3, 3] + report.height_shift_cm / 100 * UP, atol=1e-9)
+    untouched = ~np.any([leg.changed for leg in report.legs], axis=0)
+    np.testing.assert_allclose(p1[untouched][..., :3, :3], p0[untouched][..., :3, :3], atol=1e-9)
+
+
+def _angle(r0, r1):
+    """(F,) degrees between two stacks of rotation matrices."""
+    rel = np.swapaxes(r0, -1, -2) @ r1
+    return np.degrees(np.arccos(np.clip((np.trace(rel, axis1=-2, axis2=-1) - 1) / 2, -1, 1)))

@@ -91,7 +91,8 @@ def bake_motion(obj: bpy.types.Object, motion: BakedMotion, action_name: str,
     extra_curves: (data_path, group, values (C,)) constant channels keyed once at the first frame (e.g.
     Rigify's FK switches). The Action the object had stays in the file (it gets a fake user if this bake
     would leave it with none), so baking never loses the user's animation.
-    keys: a key_reduction.Reduction (indices kept per bone and for the root location), or None for all.
+    keys: a key_reduction.Reduction (indices kept per bone, for the root location and for root motion's root
+    bone), or None for all.
     into_current: key into the Action the object plays (replacing its keys in the baked frame range).
     """
     if into_current:
@@ -111,7 +112,7 @@ def bake_motion(obj: bpy.types.Object, motion: BakedMotion, action_name: str,
                       keys.location_keys if keys is not None else None, into_current)
     for bone, location in motion.extras.get("locations", {}).items():  # root motion's root bone
         _write_curves(channelbag, f'pose.bones["{escape_identifier(bone)}"].location', bone, frames, location,
-                      None, into_current)
+                      keys.other_location_keys.get(bone) if keys is not None else None, into_current)
     for data_path, group, values in extra_curves:
         _write_curves(channelbag, data_path, group, frames[:1], np.reshape(values, (1, -1)), None, into_current)
     ad = obj.animation_data or obj.animation_data_create()
