@@ -21,8 +21,7 @@ import numpy as np
 from .foot_contacts import RAMP_S, detect_contacts, intervals, pin_weights
 from .quat import conjugate, from_matrix, make_continuous, mul, normalize, to_matrix
 from .target_rig import evaluate_pose
-from .toe_floor import (axis_angle_quats, eased, needed_pitch, pitch_axes, pitch_room, rest_pitch_axis, tip_bones,
-                        tips)
+from .toe_floor import axis_angle_quats, eased, needed_pitch, pitch_axes, pitch_room, rest_pitch_axis, tip_bones, tips
 
 FEET_MODES = ("lock", "floor", "off")
 PIN_HEIGHT_PERCENTILE = 90
