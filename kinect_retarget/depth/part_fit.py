@@ -1,38 +1,79 @@
 """Body-part joint proposals into the fitted skeleton.
 
 The kinematic fit (skeleton_fit.py) loses arms that move in front of the body; the forest's proposals
-(part_proposals.py) see the elbow and wrist parts wherever they are. A joint the fit itself doubts (reported
-inferred) moves to a confident proposal nearby that is not nearer the other side's joint: the arm as a chain
-with the calibrated bone lengths (shoulder -> elbow -> wrist -> hand). Options below (chosen on the real-
-depth benchmark's subjects 1-2 within the synthetic benchmark's bound, docs/depth_tracking.md) also take
-head, shoulders and feet from proposals and report confident proposals tracked. Hips and knees never do
-(their proposals sat 20-25 cm low on real depth).
+(part_proposals.py) see the elbow and hand parts wherever they are. A proposal is where its part is densest;
+its joint sits a learned offset from there (Shotton et al. 2011 learn one per joint): `JOINT_OFFSETS`, in the
+body's frame (outward, up, forward), learned on rendered MakeHuman bodies by tools/learn_joint_offsets.py.
+Joints in DIRECT (head, shoulders; elbows and hands with ARMS = "direct") take a confident proposal near the
+fit that is not nearer the other side's joint; the wrist then sits a hand's length before the hand, on the
+line from the elbow. ARMS = "chain" instead moves only the arm joints the fit doubts, as a chain with the
+calibrated bone lengths. Hips and knees never take proposals (theirs sat 20-25 cm low on real legs); feet do
+when no floor was found. Settings chosen on the real-depth benchmark's subjects 1-2 within the synthetic
+benchmark's bound (docs/depth_tracking.md).
 """
 from __future__ import annotations
 
+import os
+from functools import lru_cache
+
 import numpy as np
 
+from ..assets import ASSETS_DIR
 from ..core.skeletons import INFERRED, KINECT_V1, TRACKED
 from . import body_model_fit as bm
+from .two_bone import two_bone_candidates
 
 J = KINECT_V1.index
 SIDES = ("Left", "Right")
+OFFSETS_PATH = os.fspath(ASSETS_DIR / "part_joint_offsets.npz")
 USE_CONFIDENCE = 0.0006     # square metres of likely part around a proposal from which it is used
-TRACK_CONFIDENCE = 0.0008   # ... and from which its joint is reported tracked
-# What takes proposals. Chosen on the real-depth benchmark's subjects 1-2 under the synthetic benchmark's bound
-# (no regression, no tracked sample beyond 15 cm): head, shoulders and feet taken from proposals measured far
-# better against the SDK (feet 20 -> 5 cm) but worse against the MakeHuman joints of the synthetic benchmark
-# (its joints sit elsewhere in the parts: no learned per-joint offset yet), and promoting confident proposals
-# to tracked let 2-3 samples per synthetic motion beyond 15 cm.
-DIRECT: tuple[str, ...] = ()   # joints taken as proposed (e.g. "Head", "ShoulderLeft")
-CHAIN = True                # arms as a chain with calibrated bone lengths (else elbows and wrists as proposed)
+TRACK_CONFIDENCE = 0.0008   # ... and from which its joint is reported tracked (with PROMOTE)
+DIRECT: tuple[str, ...] = ("Head", "ShoulderCenter", "ShoulderLeft", "ShoulderRight")   # taken as proposed
+ARMS = "direct"             # "direct": elbows and hands as proposed; "chain": doubted arm joints as a chain
+CHAIN = True                # (chain mode) with calibrated bone lengths (else elbows and wrists as proposed)
 WRISTS = True
 FEET = False                # feet (and ankles with them) from proposals, also when a floor is in view
-ONLY_INFERRED = True        # proposals only for joints the fit itself doubts (its tracked joints stay)
+ONLY_INFERRED = True        # (chain mode) proposals only for joints the fit itself doubts
 PROMOTE = False             # a joint moved to a confident proposal is reported tracked
 HANDS = True                # the hand from its own proposal (else along the forearm from the wrist)
 AGREE = 0.10                # a tracked joint moved farther than this (m) by a proposal is reported inferred
 MAX_MOVE = 0.35             # m a proposal may move its joint from the fit (farther: another part mistaken)
+ARM_REACH = False           # an arm joint the fit doubts may move farther, within the arm's reach of its shoulder
+FEET_APART = 0.08           # m: foot proposals nearer each other than this are one foot seen twice
+NO_OFFSET = ("AnkleLeft", "AnkleRight", "FootLeft", "FootRight")   # proposals used as found (see below)
+OUTWARD = np.array([1.0 if "Left" in n else -1.0 if "Right" in n else 0.0 for n in KINECT_V1.joints])
+
+
+@lru_cache(maxsize=2)
+def load_offsets(path: str = OFFSETS_PATH) -> np.ndarray:
+    """(20, 3) offsets from part centre to joint, metres in the body frame (outward, up, forward); zeros
+    when the file is missing or unreadable (proposals then stand for their joints as found)."""
+    try:
+        with np.load(path, allow_pickle=False) as d:
+            off = np.asarray(d["offsets"], dtype=np.float64)
+        return off if off.shape == (20, 3) and np.all(np.isfinite(off)) else np.zeros((20, 3))
+    except (OSError, KeyError, ValueError):
+        return np.zeros((20, 3))
+
+
+def body_frame(lateral: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """(3, 3) rows: the performer's left, up (the torso axis), forward (out of the chest)."""
+    up = _unit(axis)
+    left = _unit(lateral - (lateral @ up) * up)
+    return np.stack([left, up, np.cross(left, up)])
+
+
+def joint_positions(props, frame: np.ndarray | None, offsets: np.ndarray | None = None) -> np.ndarray:
+    """(20, 3) joints from the proposals: each part's centre moved by its joint's learned offset, turned
+    into camera space by the body `frame` (body_frame; None: the centres as found)."""
+    if frame is None:
+        return props.positions.copy()
+    off = (load_offsets() if offsets is None else offsets).copy()
+    # MakeHuman's foot joint is the toe's base, the SDK's sits further back: as found, foot proposals were
+    # 3.9-5.3 cm from the SDK's feet on real depth, with the learned offset (4 cm forward) worse
+    off[[J(n) for n in NO_OFFSET]] = 0.0
+    local = off * np.stack([np.where(OUTWARD == 0, 1.0, OUTWARD), np.ones(20), np.ones(20)], axis=1)
+    return props.positions + local @ frame
 
 
 def _unit(v):
@@ -43,59 +84,100 @@ def _state(c: float) -> int:
     return TRACKED if PROMOTE and c >= TRACK_CONFIDENCE else INFERRED
 
 
-def _usable(conf, p, pos, st, no_floor: bool, in_view):
+def _usable(conf, p, pos, st, no_floor: bool, in_view, chain: bool, height=None):
     """(20,) bool: confident proposals near their joint of the fit, and not nearer the other side's joint
     (left and right parts confused: taking it would swap the limbs)."""
     move = np.linalg.norm(p - pos, axis=1)
-    ok = (conf >= USE_CONFIDENCE) & (move <= MAX_MOVE) & in_view
-    if ONLY_INFERRED:
-        feet = [J(f"{n}{s}") for n in ("Foot", "Ankle") for s in SIDES]
-        keep = ok[feet].copy()
-        ok &= st != TRACKED
-        if no_floor:
-            ok[feet] = keep
+    near = move <= MAX_MOVE
+    if ARM_REACH and height is not None:
+        for s in SIDES:
+            sh = pos[J(f"Shoulder{s}")]
+            for n, r in (("Elbow", bm.UPPER_ARM), ("Hand", bm.UPPER_ARM + bm.FOREARM + bm.HAND)):
+                k = J(f"{n}{s}")
+                near[k] |= st[k] != TRACKED and np.linalg.norm(p[k] - sh) < 1.15 * r * height + 0.05
+    ok = (conf >= USE_CONFIDENCE) & near & in_view
+    if ONLY_INFERRED and chain:
+        arms = [J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand") for s in SIDES]
+        ok[arms] &= st[arms] != TRACKED
     for s, o in (("Left", "Right"), ("Right", "Left")):
         for n in ("Shoulder", "Elbow", "Wrist", "Hand", "Ankle", "Foot"):
             j, k = J(f"{n}{s}"), J(f"{n}{o}")
-            ok[j] &= bool(np.linalg.norm(p[j] - pos[k]) > move[j])
+            ok[j] &= bool(np.linalg.norm(p[j] - pos[k]) > move[j]) or (ARM_REACH and st[j] != TRACKED and st[k] != TRACKED)
     return ok
 
 
+def _arm_chain(pos, st, p, conf, use, s, height) -> None:
+    sh, el, wr, ha = (J(f"{n}{s}") for n in ("Shoulder", "Elbow", "Wrist", "Hand"))
+    if use[el]:
+        pos[el] = pos[sh] + _unit(p[el] - pos[sh]) * bm.UPPER_ARM * height if CHAIN else p[el]
+        st[el] = _state(conf[el])
+    if WRISTS and use[wr]:
+        pos[wr] = pos[el] + _unit(p[wr] - pos[el]) * bm.FOREARM * height if CHAIN else p[wr]
+        pos[ha] = pos[wr] + _unit(pos[wr] - pos[el]) * bm.HAND * height
+        st[wr] = st[ha] = _state(conf[wr])
+    if HANDS and use[ha]:
+        pos[ha] = pos[wr] + _unit(p[ha] - pos[wr]) * bm.HAND * height if CHAIN else p[ha]
+        st[ha] = _state(conf[ha])
+
+
+def _arm_direct(pos, st, p, conf, use, s, height) -> None:
+    el, wr, ha = (J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand"))
+    if use[el]:
+        pos[el], st[el] = p[el], _state(conf[el])
+    if use[ha]:
+        pos[ha], st[ha] = p[ha], _state(conf[ha])
+        pos[wr], st[wr] = pos[ha] - _unit(pos[ha] - pos[el]) * bm.HAND * height, _state(min(conf[el], conf[ha]))
+
+
+def _foot(pos, st, p, conf, in_view, s, height, frame) -> None:
+    """The foot from its proposal, the ankle moved with it and the knee re-solved between hip and ankle. The
+    fit's feet are no gate here (without a floor they are the least sure part of it: a third of its real feet
+    lay more than 35 cm off, or nearer the other foot): the two foot proposals must be apart, within the leg's
+    reach of the hip, and on their own side of each other."""
+    o = "Right" if s == "Left" else "Left"
+    hip, kn, an, ft = (J(f"{n}{s}") for n in ("Hip", "Knee", "Ankle", "Foot"))
+    other = J(f"Foot{o}")
+    reach = (bm.THIGH + bm.SHIN + bm.FOOT) * height + 0.10
+    side = 1.0 if s == "Left" else -1.0
+    apart = p[ft] - p[other]
+    ok = (conf[ft] >= USE_CONFIDENCE and conf[other] >= USE_CONFIDENCE and bool(np.atleast_1d(in_view)[ft] if
+          np.ndim(in_view) else in_view) and np.linalg.norm(apart) > FEET_APART
+          and np.linalg.norm(p[ft] - pos[hip]) < reach and (frame is None or side * (apart @ frame[0]) > -0.05))
+    if not ok:
+        return
+    delta = p[ft] - pos[ft]
+    pos[an], pos[ft] = pos[an] + delta, p[ft]
+    cands, _ = two_bone_candidates(pos[hip], pos[an], bm.THIGH * height, bm.SHIN * height)
+    guess = pos[kn] + 0.5 * delta
+    pos[kn] = cands[int(np.argmin(np.linalg.norm(cands - guess, axis=1)))]
+    if FEET:
+        st[ft], st[an] = _state(conf[ft]), _state(conf[ft])
+
+
 def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_floor: bool = False,
-                    in_view=True) -> None:
-    """Move joints to confident proposals, in place (positions (20, 3), states (20,)). `no_floor`: no floor
-    was found, so nothing removed what lies below the feet (a pre-segmented frame keeps shadows and floor
-    specks there, where the foot's extremity lands): the feet take their proposals whatever the fit says.
-    `in_view` ((20,) bool): joints the fit placed inside the image (one continued past its edge keeps its
-    place: the part seen at the edge is not its end)."""
-    conf, p = props.confidence, props.positions
-    use = _usable(conf, p, pos, st, no_floor, in_view)
-    before_st = st.copy()
+                    in_view=True, frame: np.ndarray | None = None, turned: bool = False) -> None:
+    """Move joints to confident proposals, in place (positions (20, 3), states (20,)). `frame`: the body's
+    frame (body_frame) for the learned offsets (None: proposals stand for their joints as found).
+    `no_floor`: no floor was found, so nothing removed what lies below the feet (a pre-segmented frame keeps
+    shadows and floor specks there, where the foot's extremity lands): the feet take their proposals whatever
+    the fit says. `in_view` ((20,) bool): joints the fit placed inside the image (one continued past its edge
+    keeps its place: the part seen at the edge is not its end). `turned`: the performer is turned well away
+    from the sensor, where the forest confuses the arms' sides (the synthetic hop's 55 degree turn swapped the
+    hands): arms then move as a chain, only where the fit doubts them."""
+    conf, p = props.confidence, joint_positions(props, frame)
+    chain = ARMS == "chain" or turned
+    use = _usable(conf, p, pos, st, no_floor, in_view, chain, height)
+    before, before_st = pos.copy(), st.copy()
     for name in DIRECT:
         j = J(name)
         if use[j]:
             pos[j], st[j] = p[j], _state(conf[j])
     for s in SIDES:
-        sh, el, wr, ha = (J(f"{n}{s}") for n in ("Shoulder", "Elbow", "Wrist", "Hand"))
-        before = pos.copy()
-        if use[el]:
-            pos[el] = pos[sh] + _unit(p[el] - pos[sh]) * bm.UPPER_ARM * height if CHAIN else p[el]
-            st[el] = _state(conf[el])
-        if WRISTS and use[wr]:
-            pos[wr] = pos[el] + _unit(p[wr] - pos[el]) * bm.FOREARM * height if CHAIN else p[wr]
-            pos[ha] = pos[wr] + _unit(pos[wr] - pos[el]) * bm.HAND * height
-            st[wr] = st[ha] = _state(conf[wr])
-        if HANDS and use[ha]:
-            pos[ha] = pos[wr] + _unit(p[ha] - pos[wr]) * bm.HAND * height if CHAIN else p[ha]
-            st[ha] = _state(conf[ha])
-        for j in (el, wr, ha):   # the fit's tracked joints stay tracked only where the proposal agrees
-            if before_st[j] == TRACKED and np.linalg.norm(pos[j] - before[j]) > AGREE:
-                st[j] = INFERRED
-            elif before_st[j] == TRACKED:
-                st[j] = TRACKED
-        ft, an = J(f"Foot{s}"), J(f"Ankle{s}")
-        if (FEET or no_floor) and use[ft]:
-            pos[an] = pos[an] + (p[ft] - pos[ft])
-            pos[ft] = p[ft]
-            if FEET:
-                st[ft], st[an] = _state(conf[ft]), _state(max(conf[ft], conf[an]))
+        (_arm_chain if chain else _arm_direct)(pos, st, p, conf, use, s, height)
+        if FEET or no_floor:
+            _foot(pos, st, p, conf, in_view, s, height, frame)
+    # the fit's tracked joints stay tracked where the proposal agrees with them
+    moved = np.linalg.norm(pos - before, axis=1)
+    st[(before_st == TRACKED) & (moved <= AGREE)] = TRACKED
+    if not PROMOTE:
+        st[(before_st == TRACKED) & (moved > AGREE)] = INFERRED

@@ -49,6 +49,7 @@ class FitResult:
     projector: "Projector | None" = None          # for the confidence checks after the fit
     edge_on: bool = False                          # the chest's normal was unusable (seen side-on)
     turned: bool = False                           # facing more than TURNED_DEG away from the sensor
+    axis: np.ndarray | None = None                 # the torso's up axis (with `lateral`, the body's frame)
 
 
 class Projector:
@@ -168,7 +169,7 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
     if turned:
         for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
             st[J[name]] = INFERRED
-    return FitResult(pos, st, lat, labels, centre, proj, edge_on or narrow, turned)
+    return FitResult(pos, st, lat, labels, centre, proj, edge_on or narrow, turned, axis)
 
 
 def _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, prev_centre):

@@ -1,0 +1,140 @@
+"""Joint proposals into the fitted skeleton (depth/part_fit.py): the learned part-to-joint offsets, arms taken
+directly, feet without a floor, and the refusals that keep left and right apart."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from kinect_retarget.core.skeletons import INFERRED, KINECT_V1, TRACKED
+from kinect_retarget.depth import part_fit
+from kinect_retarget.depth.body_parts import PARTS
+from kinect_retarget.depth.part_proposals import Proposals
+from kinect_retarget.depth.skeleton_tracker import SkeletonTracker
+
+j = KINECT_V1.index
+FACING = part_fit.body_frame(np.array([-1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))   # facing the sensor
+
+
+def _proposals(pos, conf=0.01):
+    return Proposals(pos.copy(), np.full(20, conf), (np.zeros(0, int), np.zeros(0, int)), np.zeros((0, len(PARTS))))
+
+
+def _standing_pose():
+    pos = np.zeros((20, 3))
+    pos[:, 2] = 2.5
+    for s, x in (("Left", -0.17), ("Right", 0.17)):   # the performer's left on the sensor's right (-X)
+        pos[j(f"Shoulder{s}")] = [x, 0.4, 2.5]
+        pos[j(f"Elbow{s}")] = [x, 0.12, 2.5]
+        pos[j(f"Wrist{s}")] = [x, -0.12, 2.5]
+        pos[j(f"Hand{s}")] = [x, -0.2, 2.5]
+        pos[j(f"Hip{s}")] = [x / 2, -0.1, 2.5]
+        pos[j(f"Knee{s}")] = [x / 2, -0.5, 2.45]
+        pos[j(f"Ankle{s}")] = [x / 2, -0.9, 2.5]
+        pos[j(f"Foot{s}")] = [x / 2, -0.95, 2.45]
+    return pos, np.full(20, TRACKED, np.uint8)
+
+
+def test_shipped_offsets_are_small_and_mirrored():
+    off = part_fit.load_offsets()
+    assert off.shape == (20, 3) and np.any(off != 0), f"{part_fit.OFFSETS_PATH} is missing or unreadable"
+    assert np.all(np.abs(off) < 0.08)   # a part's centre lies within a limb's radius of its joint
+    for n in KINECT_V1.joints:
+        if "Left" in n:   # (outward, up, forward): the same for both sides of a symmetric body
+            assert np.allclose(off[j(n)], off[j(n.replace("Left", "Right"))]), n
+    assert off[j("ShoulderLeft"), 2] > 0.01   # the shoulder joint sits in front of the shoulder part's centre
+
+
+def test_unreadable_offsets_are_zero(tmp_path):
+    bad = tmp_path / "offsets.npz"
+    bad.write_bytes(b"not offsets")
+    assert np.array_equal(part_fit.load_offsets(str(bad)), np.zeros((20, 3)))
+
+
+def test_offsets_turn_with_the_body_and_mirror_outward():
+    off = np.zeros((20, 3))
+    off[j("HandLeft")] = off[j("HandRight")] = [0.02, 0.0, 0.03]   # outward 2 cm, forward 3 cm
+    pos, _ = _standing_pose()
+    out = part_fit.joint_positions(_proposals(pos), FACING, off)
+    # facing the sensor: the left is -X, forward is toward the sensor (-Z)
+    assert np.allclose(out[j("HandLeft")] - pos[j("HandLeft")], [-0.02, 0.0, -0.03])
+    assert np.allclose(out[j("HandRight")] - pos[j("HandRight")], [0.02, 0.0, -0.03])
+    turned = part_fit.body_frame(np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0]))   # turned 90 degrees
+    out = part_fit.joint_positions(_proposals(pos), turned, off)
+    assert np.allclose(out[j("HandLeft")] - pos[j("HandLeft")], [-0.03, 0.0, 0.02])
+    assert np.array_equal(part_fit.joint_positions(_proposals(pos), None, off), pos)
+
+
+@pytest.fixture
+def no_offsets(monkeypatch):
+    monkeypatch.setattr(part_fit, "load_offsets", lambda path=None: np.zeros((20, 3)))
+
+
+def test_arms_take_proposals_directly_and_never_across_sides(no_offsets):
+    pos, st = _standing_pose()
+    props = _proposals(pos)
+    props.positions[j("ElbowLeft")] = [-0.37, 0.3, 2.4]      # the left arm raised sideways
+    props.positions[j("HandLeft")] = [-0.38, 0.0, 2.4]
+    props.positions[j("HandRight")] = [-0.2, -0.15, 2.5]     # nearer the left hand: left and right confused
+    before = pos.copy()
+    part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    assert np.allclose(pos[j("ElbowLeft")], [-0.37, 0.3, 2.4]) and np.allclose(pos[j("HandLeft")], [-0.38, 0.0, 2.4])
+    # the wrist a hand's length before the hand, on the line from the elbow
+    fore = pos[j("HandLeft")] - pos[j("ElbowLeft")]
+    w = pos[j("WristLeft")] - pos[j("ElbowLeft")]
+    assert np.isclose(np.linalg.norm(pos[j("HandLeft")] - pos[j("WristLeft")]), part_fit.bm.HAND * 1.7)
+    assert np.isclose(w @ fore, np.linalg.norm(w) * np.linalg.norm(fore))
+    # moved far from the fit's tracked joint: no longer claimed tracked
+    assert st[j("ElbowLeft")] == INFERRED and st[j("HandLeft")] == INFERRED
+    assert np.array_equal(pos[j("HandRight")], before[j("HandRight")]) and st[j("HandRight")] == TRACKED
+    assert np.allclose(pos[j("ShoulderLeft")], before[j("ShoulderLeft")]) and st[j("ShoulderLeft")] == TRACKED
+
+
+def test_turned_performer_moves_only_doubted_arm_joints_as_a_chain(no_offsets):
+    pos, st = _standing_pose()
+    st[j("ElbowLeft")] = INFERRED
+    props = _proposals(pos)
+    props.positions[j("ElbowLeft")] = [-0.37, 0.35, 2.4]
+    props.positions[j("HandRight")] = [0.3, 0.3, 2.4]        # the fit tracks this hand: it stays
+    before = pos.copy()
+    part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING, turned=True)
+    moved = pos[j("ElbowLeft")] - pos[j("ShoulderLeft")]
+    assert np.isclose(np.linalg.norm(moved), part_fit.bm.UPPER_ARM * 1.7)   # the calibrated upper arm
+    assert moved[0] < -0.15 and st[j("ElbowLeft")] == INFERRED
+    assert np.array_equal(pos[j("HandRight")], before[j("HandRight")]) and st[j("HandRight")] == TRACKED
+
+
+def test_feet_without_a_floor_follow_their_proposals_and_refuse_one_foot_seen_twice(no_offsets):
+    pos, st = _standing_pose()
+    fit = pos.copy()
+    fit[j("FootLeft")] = fit[j("FootRight")] + [0.02, 0, 0]   # the fit put both feet on the right one
+    props = _proposals(pos)
+    p, s = fit.copy(), st.copy()
+    part_fit.apply_proposals(p, s, props, 1.7, no_floor=True, frame=FACING)
+    assert np.allclose(p[j("FootLeft")], pos[j("FootLeft")])
+    thigh, shin = (np.linalg.norm(p[j(a)] - p[j(b)]) for a, b in (("HipLeft", "KneeLeft"), ("KneeLeft", "AnkleLeft")))
+    assert np.isclose(thigh, part_fit.bm.THIGH * 1.7) and abs(shin - part_fit.bm.SHIN * 1.7) < 0.01
+    props.positions[j("FootLeft")] = props.positions[j("FootRight")] + [0.03, 0, 0]   # one foot, both labels
+    p = fit.copy()
+    part_fit.apply_proposals(p, st.copy(), props, 1.7, no_floor=True, frame=FACING)
+    assert np.array_equal(p[j("FootLeft")], fit[j("FootLeft")])
+    p = fit.copy()   # with a floor in view the fit's feet stand
+    part_fit.apply_proposals(p, st.copy(), _proposals(pos), 1.7, no_floor=False, frame=FACING)
+    assert np.array_equal(p[j("FootLeft")], fit[j("FootLeft")])
+
+
+def test_learned_offsets_bring_proposals_nearer_rendered_joints(rendered):
+    """On rendered frames the offsets (learned on other clips) move confident proposals toward the true joints."""
+    seq, _ = rendered
+    tracker = SkeletonTracker(gravity=seq.gravity)
+    raw, moved = [], []
+    names = [n for n in part_fit.DIRECT + ("ElbowLeft", "ElbowRight", "HandLeft", "HandRight")]
+    for f in range(len(seq.mm)):
+        tracker.update(seq.mm[f], seq.times[f])
+        props, fit = tracker.last_proposals, tracker.last_good
+        frame = part_fit.body_frame(fit.lateral, fit.axis)
+        ok = [j(n) for n in names if props.confidence[j(n)] >= part_fit.USE_CONFIDENCE]
+        raw.append(np.linalg.norm(props.positions[ok] - seq.joints[f, ok], axis=1))
+        moved.append(np.linalg.norm(part_fit.joint_positions(props, frame)[ok] - seq.joints[f, ok], axis=1))
+    raw, moved = np.concatenate(raw), np.concatenate(moved)
+    assert len(raw) > 40
+    assert moved.mean() < raw.mean() - 0.005 and moved.mean() < 0.06
