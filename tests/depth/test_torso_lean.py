@@ -6,7 +6,7 @@ import numpy as np
 
 from kinect_retarget.core.skeletons import KINECT_V1
 from kinect_retarget.depth import skeleton_fit
-from kinect_retarget.depth.skeleton_tracker import SkeletonTracker
+from kinect_retarget.depth.skeleton_tracker import SkeletonTracker, TrackerSettings
 
 J = KINECT_V1.index
 
@@ -17,7 +17,8 @@ def _trunk(p):
 
 
 def _trunk_errors(seq):
-    tracker = SkeletonTracker(gravity=seq.gravity)
+    # the fit's own torso axis (the shoulder centre's body-part proposal would follow the lean either way)
+    tracker = SkeletonTracker(gravity=seq.gravity, settings=TrackerSettings(part_forest=None))
     out = []
     for i in range(len(seq.mm)):
         pos, _ = tracker.update(seq.mm[i], seq.times[i])
