@@ -104,23 +104,39 @@ def _draw() -> None:
 
 
 def _draw_gpu(geometries: list[OverlayGeometry]) -> None:
+    """Lines with POLYLINE_FLAT_COLOR (uniforms viewportSize, lineWidth) and joints with POINT_FLAT_COLOR (uniform
+    size), Blender 5.0's builtin names (gpu_py_shader.cc). The point shader's `size` only counts with program
+    point size on (as Blender's own point drawing does); every state changed here is put back afterwards."""
     import gpu
     from gpu_extras.batch import batch_for_shader
     region = bpy.context.region
+    viewport = (region.width, region.height) if region is not None else tuple(gpu.state.viewport_get()[2:])
     lines = gpu.shader.from_builtin("POLYLINE_FLAT_COLOR")
     points = gpu.shader.from_builtin("POINT_FLAT_COLOR")
+    blend, depth, width = gpu.state.blend_get(), gpu.state.depth_test_get(), gpu.state.line_width_get()
     gpu.state.blend_set("ALPHA")
     gpu.state.depth_test_set("NONE")  # in front of the character, like an armature's In Front
-    for g in geometries:
-        if len(g.lines):
-            lines.bind()
-            lines.uniform_float("viewportSize", (region.width, region.height))
-            lines.uniform_float("lineWidth", LINE_WIDTH)
-            batch_for_shader(lines, "LINES", {"pos": g.lines, "color": g.line_colors}).draw(lines)
-        points.bind()
-        points.uniform_float("size", POINT_SIZE)
-        batch_for_shader(points, "POINTS", {"pos": g.points, "color": g.point_colors}).draw(points)
-    gpu.state.blend_set("NONE")
+    gpu.state.program_point_size_set(True)
+    try:
+        for g in geometries:
+            if len(g.lines):
+                lines.bind()
+                lines.uniform_float("viewportSize", viewport)
+                lines.uniform_float("lineWidth", LINE_WIDTH)
+                batch_for_shader(lines, "LINES", {"pos": _f32(g.lines), "color": _f32(g.line_colors)}).draw(lines)
+            points.bind()
+            points.uniform_float("size", POINT_SIZE)
+            batch_for_shader(points, "POINTS", {"pos": _f32(g.points), "color": _f32(g.point_colors)}).draw(points)
+    finally:
+        gpu.state.program_point_size_set(False)
+        gpu.state.line_width_set(width)
+        gpu.state.depth_test_set(depth)
+        gpu.state.blend_set(blend)
+
+
+def _f32(a: np.ndarray) -> np.ndarray:
+    """A vertex buffer fills from an array's raw bytes (no conversion): float32, contiguous."""
+    return np.ascontiguousarray(a, dtype=np.float32)
 
 
 def draw_settings(layout, s) -> None:
