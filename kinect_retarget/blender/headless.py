@@ -56,6 +56,36 @@ def open_blend(path: str) -> None:
         raise ValueError(f"{path}: not a readable .blend file ({message})") from None
 
 
+def append_armature(path: str, name: str | None) -> bpy.types.Object:
+    """Append the objects of another rig file into this scene (in a collection named after the file) and
+    return its named (or only) armature; a name already taken here gets Blender's .001 suffix."""
+    if not os.path.isfile(path):
+        raise ValueError(f"{path}: rig file not found")
+    try:
+        with bpy.data.libraries.load(os.path.abspath(path), link=False) as (source, target):
+            names = list(source.objects)
+            target.objects = list(names)  # filled in place with the objects
+    except OSError as exc:
+        raise ValueError(f"{path}: not a readable .blend file ({exc})") from None
+    collection = bpy.data.collections.new(os.path.splitext(os.path.basename(path))[0])
+    bpy.context.scene.collection.children.link(collection)
+    loaded = {n: o for n, o in zip(names, target.objects) if o is not None}
+    for obj in loaded.values():
+        collection.objects.link(obj)
+    arms = {n: o for n, o in loaded.items() if o.type == "ARMATURE"}
+    listing = ", ".join(arms) or "none"
+    if name:
+        if name not in arms:
+            raise ValueError(f"{path}: no armature named {name!r} (armatures: {listing})")
+        return arms[name]
+    shown = [o for o in arms.values() if not o.hide_viewport and not o.hide_get()]
+    pick = list(arms.values()) if len(arms) <= 1 else shown
+    if len(pick) != 1:
+        raise ValueError(f"{path}: " + ("no armature in the file" if not arms else
+                                        f"several armatures ({listing}): name one with --armature"))
+    return pick[0]
+
+
 def open_target(rig_path: str | None, armature: str | None, preset: str, generate) -> tuple[bpy.types.Object, str]:
     """(armature, preset) to drive: the named (or only) armature of `rig_path`, or the rig `generate(scene)`
     builds in an empty file, for which preset "auto" means its own ("kinect")."""
@@ -86,10 +116,11 @@ def bake_to_file(take: Take, out_path: str, *, rig_path: str | None = None, arma
 def bake_bodies_to_file(takes: list[Take], out_path: str, *, rig_path: str | None = None,
                         armatures: list[str | None] | None = None, preset: str = "auto",
                         overrides: dict | None = None, settings: RetargetSettings | None = None,
-                        options: BakeOptions | None = None) -> dict:
+                        options: BakeOptions | None = None, rig_paths: list[str] | None = None) -> dict:
     """Several performers of one take (`takes[k]` one body each), each baked onto its own armature: the
-    armatures named in rig_path, paired in order, or a generated Kinect rig per body. Saves one .blend;
-    returns {"out", "performers": [one summary per body]}."""
+    armatures named in rig_path, paired in order; or with rig_paths, each body's armature from its own file
+    (the first file is opened, the others' objects appended); or a generated Kinect rig per body. Saves one
+    .blend; returns {"out", "performers": [one summary per body]}."""
     from .io.rig_export import check_export_path
     if check_export_path(out_path) != "blend":
         raise ValueError(f"{out_path}: several performers go into one .blend; export one body per file "
@@ -97,7 +128,12 @@ def bake_bodies_to_file(takes: list[Take], out_path: str, *, rig_path: str | Non
     names = list(armatures or [None] * len(takes))
     if len(names) != len(takes):
         raise ValueError(f"{len(takes)} bodies need {len(takes)} armatures, got {len(names)}")
-    if rig_path:
+    if rig_paths:
+        if len(rig_paths) != len(takes):
+            raise ValueError(f"{len(takes)} bodies need {len(takes)} rig files, got {len(rig_paths)}")
+        open_blend(rig_paths[0])
+        objs = [find_armature(names[0])] + [append_armature(p, n) for p, n in zip(rig_paths[1:], names[1:])]
+    elif rig_path:
         if any(n is None for n in names) or len(set(names)) != len(names):
             raise ValueError("name a different armature in the rig file for each body (--armature, in order)")
         open_blend(rig_path)

@@ -8,7 +8,7 @@ import os
 import sys
 
 from ..core.kinect_rig_layout import typical_segment_lengths
-from .performer_args import add_performer_args, performers
+from .performer_args import add_performer_args, performers, single_rig
 
 
 def add_parsers(sub) -> None:
@@ -65,13 +65,14 @@ def run_live(args) -> int:
                                  bodies=tuple(b for b, _ in pairs))
     except SourceError as exc:  # bad input fails before Blender starts
         raise ValueError(str(exc)) from None
+    rig = single_rig(args, "live")
     overrides = None
     if args.mapping:
         from ..core.presets import load_mapping_file
         overrides = load_mapping_file(args.mapping)
 
     lengths = None
-    if not args.rig:  # bone lengths of the generated rig: the take's, or typical ones for live devices
+    if not rig:  # bone lengths of the generated rig: the take's, or typical ones for live devices
         take = getattr(source, "take", None)
         if take is not None:
             from ..core.kinect_rig_layout import median_segment_lengths
@@ -80,7 +81,7 @@ def run_live(args) -> int:
             lengths = typical_segment_lengths(source.skeleton)
     with stdout_to_stderr():
         from ..blender.live.live_headless import run_headless
-        result = run_headless(source, args.seconds, rig_path=args.rig, performers=pairs,
+        result = run_headless(source, args.seconds, rig_path=rig, performers=pairs,
                               preset=args.preset, filter_name=args.filter, root=args.root, mirror=args.mirror,
                               overrides=overrides, record=args.record, out=args.out, rig_lengths=lengths)
         result = {"source": args.source, **result}

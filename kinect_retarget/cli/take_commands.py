@@ -13,7 +13,7 @@ from ..core.foot_lock import FEET_MODES
 from ..core.presets import PRESET_NAMES
 from ..core.retarget import ROOT_MODES
 from ..takes import body_count, load_take
-from .performer_args import add_performer_args, performers
+from .performer_args import add_performer_args, performers, rig_files
 
 
 def add_parsers(sub) -> None:
@@ -30,7 +30,8 @@ def add_parsers(sub) -> None:
     p.add_argument("take")
     p.add_argument("--out", required=True,
                    help="output .blend, or .fbx / .glb / .gltf / .bvh exported with game-engine settings")
-    add_performer_args(p, ".blend holding the target armature(s) (default: a generated Kinect rig per body)")
+    add_performer_args(p, ".blend holding the target armature(s) (default: a generated Kinect rig per body); "
+                          "repeat it with --body for each performer's rig in its own file")
     p.add_argument("--preset", choices=PRESET_NAMES, default="auto")
     p.add_argument("--mapping", help="JSON {bone: joint} overriding the preset per bone")
     p.add_argument("--filter", choices=FILTERS, default="default")
@@ -169,11 +170,13 @@ def run_bake(args) -> int:
     overrides = load_mapping_file(args.mapping) if args.mapping else None
     from ..blender.headless import bake_bodies_to_file, bake_to_file
 
+    rigs = rig_files(args, len(pairs))
     if len(pairs) == 1:
-        result = bake_to_file(takes[0], args.out, rig_path=args.rig, armature=pairs[0][1], preset=args.preset,
+        result = bake_to_file(takes[0], args.out, rig_path=rigs[0], armature=pairs[0][1], preset=args.preset,
                               overrides=overrides, settings=settings, options=options)
     else:
-        result = bake_bodies_to_file(takes, args.out, rig_path=args.rig, armatures=[a for _, a in pairs],
-                                     preset=args.preset, overrides=overrides, settings=settings, options=options)
+        result = bake_bodies_to_file(takes, args.out, rig_path=rigs[0], armatures=[a for _, a in pairs],
+                                     preset=args.preset, overrides=overrides, settings=settings, options=options,
+                                     rig_paths=rigs if len(set(rigs)) > 1 else None)
     print(json.dumps(result))
     return 0

@@ -1,6 +1,6 @@
 """Two performers of one take, each baked onto its own rig from the CLI: `--body all` (a generated rig per
-body) and `--rig FILE --armature NAME --body N` pairs (in any order); each rig follows its own body's limbs
-and not the other's."""
+body), `--rig FILE --armature NAME --body N` pairs (in any order) and `--rig FILE --body N` once per body (each
+rig in its own file); each rig follows its own body's limbs and not the other's."""
 from __future__ import annotations
 
 import json
@@ -86,6 +86,42 @@ def test_armature_body_pairs_bake_onto_the_rigs_of_a_file(bpy_empty, data_dir, t
     alice, bob = bpy.data.objects["Alice"], bpy.data.objects["Bob"]
     assert _limb_errors(bpy, alice, first, start) < 0.5 and _limb_errors(bpy, bob, second, start) < 0.5
     assert _limb_errors(bpy, bob, first, start) > 5
+
+
+def test_one_rig_file_per_body(bpy_empty, data_dir, tmp_path, two_person_take):
+    """`--rig A.blend --body 1 --rig B.blend --body 0`: each performer's rig from its own file (both armatures
+    named "rig": the second comes in as "rig.001"), baked into one .blend, each following its own body."""
+    from kinect_retarget.blender.bake_take import new_generated_rig
+    bpy = bpy_empty
+    first, second = performers(data_dir)
+    files = [tmp_path / "a.blend", tmp_path / "b.blend"]
+    for path in files:
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        new_generated_rig(bpy.context.scene, first, "rig")
+        bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    out = tmp_path / "duo.blend"
+    rc, stdout, stderr = _cli("bake", two_person_take, "--out", out, "--rig", files[0], "--body", 1,
+                              "--rig", files[1], "--body", 0, "--filter", "none", "--preset", "kinect",
+                              "--set-scene-fps", "--fps", 30, "--feet", "off")
+    assert rc == 0, stderr
+    result = json.loads(stdout.strip().splitlines()[-1])
+    assert [(p["armature"], p["body"]) for p in result["performers"]] == [("rig", 1), ("rig.001", 0)]
+    bpy.ops.wm.open_mainfile(filepath=str(out))
+    second.positions[..., 0] += 1.0
+    start = result["performers"][0]["frame_range"][0]
+    one, zero = bpy.data.objects["rig"], bpy.data.objects["rig.001"]
+    assert _limb_errors(bpy, one, second, start) < 0.5 and _limb_errors(bpy, zero, first, start) < 0.5
+    assert _limb_errors(bpy, one, first, start) > 5 and _limb_errors(bpy, zero, second, start) > 5
+    assert "b" in bpy.data.collections  # the second file's objects, in a collection named after it
+    rc, _, err = _cli("bake", two_person_take, "--out", tmp_path / "x.blend", "--rig", files[0], "--rig",
+                      files[1], "--body", 0)
+    assert rc == 2 and "2 --rig files need as many --body" in err
+    rc, _, err = _cli("bake", two_person_take, "--out", tmp_path / "x.blend", "--rig", files[0], "--rig",
+                      tmp_path / "missing.blend", "--body", 0, "--body", 1)
+    assert rc != 0 and "missing.blend: rig file not found" in err
+    rc, _, err = _cli("live", "--source", f"take:{two_person_take}", "--seconds", 1, "--rig", files[0], "--rig",
+                      files[1], "--body", 0, "--body", 1)
+    assert rc == 2 and "live: one --rig file" in err
 
 
 def test_bad_performer_arguments_are_named(tmp_path, two_person_take, data_dir):
