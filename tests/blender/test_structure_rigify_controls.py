@@ -51,6 +51,37 @@ def test_rigify_control_rig_renamed_maps_exactly_as_its_preset(bpy_empty, rigify
         assert any("control rig" in n for n in info["notes"])
 
 
+def test_rigify_rig_generated_in_a_t_pose_renamed_maps_as_its_preset(bpy_empty, tmp_path):
+    """The metarig's arms raised to horizontal before generating (the stock metarig's hang about 29° down)."""
+    import addon_utils
+    from mathutils import Matrix
+
+    from kinect_retarget.blender.io.rig_reader import target_rig_from_object
+    bpy = bpy_empty
+    addon_utils.enable("rigify", default_set=True)
+    bpy.ops.object.armature_human_metarig_add()
+    bpy.ops.object.mode_set(mode="EDIT")
+    bones = bpy.context.object.data.edit_bones
+    for side, sign in (("L", 1), ("R", -1)):
+        arm = bones[f"upper_arm.{side}"]
+        down = np.arctan2(arm.head.z - arm.tail.z, abs(arm.tail.x - arm.head.x))
+        turn = Matrix.Translation(arm.head) @ Matrix.Rotation(-sign * down, 4, "Y") @ Matrix.Translation(-arm.head)
+        chain = [arm] + list(arm.children_recursive)
+        moved = [(turn @ b.head, turn @ b.tail) for b in chain]  # first: a connected child shares its parent's tail
+        for b, (head, tail) in zip(chain, moved):
+            b.head, b.tail = head, tail
+    bpy.ops.object.mode_set(mode="OBJECT")
+    bpy.ops.pose.rigify_generate()
+    path = tmp_path / "rigify_t.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    obj, back = _open(bpy, path, 9)
+    arm = obj.data.bones[next(b for b, o in back.items() if o == "upper_arm_fk.L")]
+    assert abs(arm.tail_local.z - arm.head_local.z) < 1e-3   # the arm is level
+    rig = target_rig_from_object(obj)
+    used, mapping = build_mapping("auto", rig.bone_names, None, rig)
+    assert used == "structure" and {back[b]: j for b, j in mapping.items()} == PRESETS["rigify"]
+
+
 def test_sidebar_fills_the_table_of_the_renamed_control_rig(registered, rigify_rig_path):
     bpy = registered
     obj, back = _open(bpy, rigify_rig_path, 7)
