@@ -5,9 +5,10 @@ original-named rig (mapped by the 'rigify' preset).
     .venv/bin/python benchmarks/bench_control_rig_mapping.py [--repeat 20]
 
 Times: reading the armature (TargetRig with its links), the control-rig mapping alone (numpy), and
-build_mapping('auto') end to end, best of --repeat. Bakes: each sample take (v2 takes with hands off: finger
-bones are found by name), default options otherwise; compared are the keyed rotations of the mapped controls
-and Blender's evaluation of all 160 deform bones at every keyed frame (angle and position).
+build_mapping('auto') end to end, best of --repeat. Bakes: each sample take with the default options (on v2
+takes the hands too: finger controls found by structure on the renamed rig) and once with root motion;
+compared are the keyed rotations and Blender's evaluation of all 160 deform bones and the root at every keyed
+frame (angle and position).
 """
 from __future__ import annotations
 
@@ -56,15 +57,16 @@ def timings(path: str, repeat: int) -> None:
           f"build_mapping('auto') from the object {whole * 1000:.1f} ms (best of {repeat})")
 
 
-def bake(path: str, seed: int | None, take, hands: str):
+def bake(path: str, seed: int | None, take, root_motion: bool):
     """Keys by original bone name and (frames, deform bones, 4, 4) as Blender evaluates the baked rig."""
     import bpy
 
     from kinect_retarget.blender.bake_take import bake_take
     obj, back = open_rig(path, seed)
-    res = bake_take(obj, take, preset="auto", settings=RetargetSettings(), options=BakeOptions(hands=hands))
+    res = bake_take(obj, take, preset="auto", settings=RetargetSettings(),
+                    options=BakeOptions(root_motion=root_motion))
     keys = {back[b]: res.motion.quats[:, k] for k, b in enumerate(res.motion.bone_names)}
-    deform = sorted((back[b.name], b.name) for b in obj.data.bones if b.use_deform)
+    deform = sorted((back[b.name], b.name) for b in obj.data.bones if b.use_deform or back[b.name] == "root")
     posed = []
     for f in res.motion.frames:
         bpy.context.scene.frame_set(int(f))
@@ -84,17 +86,17 @@ def main() -> None:
     path = os.path.join(tempfile.mkdtemp(), "rigify.blend")
     rigify_file(path, body=False)
     timings(path, args.repeat)
-    for name in TAKES:
+    for name, root_motion in [(t, False) for t in TAKES] + [(TAKES[0], True)]:
         take = load_take(_common.SAMPLE_TAKES / name)
-        hands = "off" if "v2" in name else "auto"
-        p1, k1, m1 = bake(path, None, take, hands)
-        p2, k2, m2 = bake(path, 11, take, hands)
+        p1, k1, m1 = bake(path, None, take, root_motion)
+        p2, k2, m2 = bake(path, 11, take, root_motion)
         key_deg = max(float(np.degrees(angle_between(k1[b], k2[b])).max()) for b in k1) if k1.keys() == k2.keys() \
             else float("nan")
         deform_deg = float(np.degrees(angle_between(rotation(m1), rotation(m2))).max())
         deform_mm = float(np.abs(m1[..., :3, 3] - m2[..., :3, 3]).max() * 1000)
-        print(f"{name}: {len(m1)} frames, {p1} vs {p2}: same bones {k1.keys() == k2.keys()}; max difference "
-              f"keys {key_deg:.2e} deg, {m1.shape[1]} deform bones {deform_deg:.2e} deg / {deform_mm:.2e} mm")
+        print(f"{name}{' (root motion)' if root_motion else ''}: {len(m1)} frames, {p1} vs {p2}: same "
+              f"{len(k1)} keyed bones {k1.keys() == k2.keys()}; max difference keys {key_deg:.2e} deg, "
+              f"{m1.shape[1] - 1} deform bones + root {deform_deg:.2e} deg / {deform_mm:.2e} mm")
 
 
 if __name__ == "__main__":

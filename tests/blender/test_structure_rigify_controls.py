@@ -116,18 +116,24 @@ def _bake(bpy, path, seed, take, options=None):
     return res.preset, keys, switches, deform, np.array(posed)
 
 
-@pytest.mark.parametrize("root_motion", [False, True], ids=["default", "root-motion"])
-def test_bake_onto_the_renamed_rig_equals_the_bake_onto_the_original(bpy_empty, rigify_rig_path, root_motion):
-    """Default options (feet locked), and with root motion: the renamed rig's root is found as the bone its
-    torso follows by constraints, and carries the same travel as the preset's `root`."""
+@pytest.mark.parametrize("take_name,root_motion", [("kinect_v1_cmu_131_03_hop", False),
+                                                    ("kinect_v1_cmu_131_03_hop", True),
+                                                    ("kinect_v2_ges01_wavehand", False)],
+                         ids=["default", "root-motion", "v2-hands"])
+def test_bake_onto_the_renamed_rig_equals_the_bake_onto_the_original(bpy_empty, rigify_rig_path, take_name,
+                                                                      root_motion):
+    """Default options (feet locked; on a Kinect v2 take the hands too: thumb roll and finger bend on the
+    finger controls, found by structure on the renamed rig), and with root motion: the renamed rig's root is
+    found as the bone its torso follows by constraints, and carries the same travel as the preset's `root`."""
     from kinect_retarget.core.bake_options import BakeOptions
     from kinect_retarget.core.quat import angle_between, from_matrix
     from kinect_retarget.takes import load_take
-    take = load_take(SAMPLES / "kinect_v1_cmu_131_03_hop.krtake").slice(slice(0, 40))
+    take = load_take(SAMPLES / f"{take_name}.krtake").slice(slice(0, 40))
     options = BakeOptions(root_motion=root_motion)
     preset, keys, switches, deform, posed = _bake(bpy_empty, rigify_rig_path, None, take, options)
     preset2, keys2, switches2, deform2, posed2 = _bake(bpy_empty, rigify_rig_path, 11, take, options)
     assert ("root" in keys) == root_motion
+    assert ("f_index.02.L" in keys) == ("v2" in take_name)   # the hands bend the fingers
     assert (preset, preset2) == ("rigify", "structure")
     assert set(keys2) == set(keys) and switches2 == switches and len(switches) == 4 and deform2 == deform
     worst_key = max(float(np.degrees(angle_between(keys[b], keys2[b])).max()) for b in keys)

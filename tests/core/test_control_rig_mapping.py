@@ -1,14 +1,16 @@
 """Structure mapping of generated control rigs (issue 16), in numpy: the Rigify rig Blender generates (706
 bones, tests/data/rigs/rigify_generated.json) with random names and in random order maps exactly as the
 'rigify' preset; without its links (deform, shapes, constraints) it is refused, never mapped wrongly; plain
-rigs never take the control-rig route."""
+rigs never take the control-rig route; the finger controls and the root are found too."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
 from kinect_retarget.core.armature_mapping import structure_mapping_for
+from kinect_retarget.core.control_rig_fingers import finger_chains_by_structure
 from kinect_retarget.core.control_rig_mapping import Constraint, RigLinks, deform_parents, is_control_rig, map_armature
+from kinect_retarget.core.hand_pose import finger_chains
 from kinect_retarget.core.presets import PRESETS, build_mapping
 from kinect_retarget.core.root_motion import followed_root
 from kinect_retarget.core.structure_mapping import StructureError
@@ -93,3 +95,19 @@ def test_root_motion_bone_of_the_renamed_rig_is_the_root_its_torso_follows():
     torso = next(b for b, o in back.items() if o == "torso")
     assert back[followed_root(target, torso)] == "root"
     assert followed_root(anon.target(), torso) is None   # without links: nothing to follow
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_finger_controls_of_the_renamed_rig_are_the_ones_rigify_names(seed):
+    """Kinect v2's hand poses drive Rigify's finger controls, found by name (hand_pose.FINGER_NAMES); on the
+    renamed, reordered rig the same controls are found by structure, finger by finger."""
+    rig, links = rigify_controls()
+    rig, links = reordered(rig, links, seed)
+    anon, back = renamed(rig, seed)
+    for side, tag in (("Left", ".L"), ("Right", ".R")):
+        hand = next(i for i, b in enumerate(anon.names) if back[b] == "hand_fk" + tag)
+        found = finger_chains_by_structure(anon.parents, anon.heads, anon.tails, links, hand)
+        assert {f: [back[anon.names[b]] for b in chain] for f, chain in found.items()} == \
+            finger_chains(rig.names, side)
+    plain = build(LAYOUTS["ue5-mannequin"])   # other rigs: by name only
+    assert finger_chains_by_structure(plain.parents, plain.heads, plain.tails, None, 0) is None

@@ -1,6 +1,7 @@
-"""Hands on the rig: the finger bones of Rigify, Mixamo and UE Mannequin rigs, their curl axes from the rig's
-rest pose, and the bake step that rolls the hand from Kinect v2's thumb, bends the fingers toward its hand tip
-and curls them from the hand states (core/hand_pose.py). The rig itself is never changed."""
+"""Hands on the rig: the finger bones of Rigify, Mixamo and UE Mannequin rigs (a renamed Rigify rig's found by
+structure: core/control_rig_fingers.py), their curl axes from the rig's rest pose, and the bake step that rolls
+the hand from Kinect v2's thumb, bends the fingers toward its hand tip and curls them from the hand states
+(core/hand_pose.py). The rig itself is never changed."""
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
@@ -8,10 +9,12 @@ from dataclasses import dataclass, replace
 import bpy
 import numpy as np
 
+from ...core.control_rig_fingers import finger_chains_by_structure
 from ...core.conventions import kinect_to_blender
 from ...core.hand_pose import (CURL_DEG, FINGERS, finger_chains, finger_curls, finger_quats, fingers_bend,
                                hand_roll, twist_quats)
 from ...core.quat import make_continuous, normalize, to_matrix
+from .rig_reader import target_rig_from_object
 
 
 @dataclass
@@ -28,11 +31,20 @@ def _perp(v: np.ndarray, axis: np.ndarray) -> np.ndarray:
     return normalize(v - np.dot(v, axis) * axis)
 
 
+def _fingers_by_structure(obj: bpy.types.Object, hand: str) -> dict[str, list[str]] | None:
+    """A control rig's finger controls found without names (a renamed Rigify rig), else None."""
+    rig = target_rig_from_object(obj)
+    found = finger_chains_by_structure(rig.parents, rig.heads, rig.tails, rig.links, rig.index(hand))
+    return None if found is None else {f: [rig.bone_names[b] for b in chain] for f, chain in found.items()}
+
+
 def hand_rig(obj: bpy.types.Object, hand: str, side: str) -> HandRig | None:
     """The hand's finger rig from the armature's rest pose, or None when it has no four-finger chains."""
     bones = obj.data.bones
-    chains = finger_chains(bones.keys(), side)
-    if chains is None or hand not in bones:
+    if hand not in bones:
+        return None
+    chains = finger_chains(bones.keys(), side) or _fingers_by_structure(obj, hand)
+    if chains is None:
         return None
     rest = np.array(bones[hand].matrix_local)[:3, :3]
     head = np.array(bones[hand].head_local)
