@@ -210,3 +210,36 @@ def test_cli_bake_keeps_the_toes_of_feet_pointing_down_on_the_floor(bpy_empty, t
         lowest[mode] = float(np.min(tails) - floor)
     assert lowest["off"] < -0.03, lowest                                    # the toes dip without the pass
     assert lowest["lock"] >= -1e-4 and lowest["floor"] >= -1e-4, lowest  # and stay on the floor with it
+
+
+def test_the_sidebar_bake_operator_takes_feet_and_root_motion(registered, tmp_path):
+    """The Bake Take operator (the sidebar's Bake Take…) with its Feet and Root Motion options: Floor Only on a
+    walk whose feet point down keeps the toes on the floor, Off leaves them under it; Root Motion keys the
+    root bone's travel."""
+    from bpy_extras import anim_utils
+
+    from kinect_retarget.takes import krtake
+    from tests.takes.steep_feet import steep_feet
+    bpy = registered
+    obj = _armature(bpy)
+    bpy.context.view_layer.objects.active = obj
+    take_path = tmp_path / "steep.krtake"
+    krtake.write(take_path, steep_feet(load_take(SAMPLE_TAKES / "kinect_v1_cmu_131_02_walk.krtake")))
+    floor = min(min(b.head_local[2], b.tail_local[2]) for b in obj.data.bones)
+    lowest = {}
+    for feet in ("off", "floor"):
+        assert bpy.ops.kinect_retarget.bake_take(filepath=str(take_path), fps=30.0, feet=feet,
+                                                 root_motion=True) == {"FINISHED"}
+        curves = anim_utils.animdata_get_channelbag_for_assigned_slot(obj.animation_data).fcurves
+        paths = {fc.data_path for fc in curves}
+        assert 'pose.bones["root"].location' in paths                            # root motion keyed
+        root_x = next(fc for fc in curves if fc.data_path == 'pose.bones["root"].location' and fc.array_index == 1)
+        assert abs(root_x.keyframe_points[-1].co[1] - root_x.keyframe_points[0].co[1]) > 0.3  # it travels
+        keys = next(fc for fc in curves if fc.data_path.startswith('pose.bones["foot_l"].rotation')).keyframe_points
+        low = []
+        for k in list(keys)[::3]:
+            bpy.context.scene.frame_set(int(k.co[0]))
+            low.append(min((obj.matrix_world @ obj.pose.bones[b].tail)[2] for b in ("foot_l", "ball_l", "foot_r",
+                                                                                    "ball_r")))
+        lowest[feet] = min(low) - floor
+    assert lowest["off"] < -0.03 and lowest["floor"] >= -1e-4, lowest
