@@ -14,15 +14,10 @@ import bpy
 import numpy as np
 import pytest
 
-import kinect_retarget
-from kinect_retarget.blender.io.kinect_rig import build_kinect_rig
-from kinect_retarget.blender.live import live_runtime as live
 from kinect_retarget.blender.ui import source_overlay
-from kinect_retarget.core.kinect_rig_layout import median_segment_lengths
 from kinect_retarget.core.skeleton_overlay import COLORS
 from kinect_retarget.core.skeletons import INFERRED, KINECT_V2, NOT_TRACKED, TRACKED
-from kinect_retarget.takes import load_take
-from tests.takes.two_performers import write_two_person_ntu
+from tests.blender.test_source_overlay import scene  # noqa: F401 (the fixture)
 
 # Blender 5.0's builtin shaders: attributes (name -> components) and uniforms (gpu_py_shader.cc)
 SHADERS = {
@@ -119,33 +114,22 @@ def recorder(monkeypatch):
 
 
 @pytest.fixture
-def scene(data_dir, tmp_path):
-    kinect_retarget.register()
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    path = write_two_person_ntu(data_dir, tmp_path / "S001C001P001R001A050.skeleton")
-    takes = load_take(path), load_take(path, body=1)
-    sc = bpy.context.scene
-    rigs = [build_kinect_rig(sc, KINECT_V2, median_segment_lengths(t), n) for t, n in zip(takes, ("Alice", "Bob"))]
-    rigs[1].location = (3.0, 0.0, 0.0)
-    bpy.context.view_layer.update()
+def duo(request):
+    """test_source_overlay's two-performer scene, the source shown, Bob following body 1."""
+    sc, rigs, takes, _ = request.getfixturevalue("scene")
     s = sc.kinect_retarget
-    s.initialised = True
-    s.source, s.take_path, s.armature, s.show_source = "TAKE", str(path), rigs[0], True
-    sc.render.fps, sc.render.fps_base, sc.frame_start = 30, 1.0, 1
+    s.show_source = True
     item = s.performers.add()
     item.armature, item.body = rigs[1], 1
-    yield sc, rigs, takes
-    live.stop_live(bake=False)
-    kinect_retarget.unregister()
-    bpy.ops.wm.read_factory_settings(use_empty=True)
+    return sc, rigs, takes
 
 
 def _expected_colors(states):
     return {s: np.array(COLORS[s], dtype=np.float32) for s in (TRACKED, INFERRED) if s in states}
 
 
-def test_the_draw_callback_draws_each_performer_as_lines_and_points(scene, recorder):
-    sc, rigs, (a, b) = scene
+def test_the_draw_callback_draws_each_performer_as_lines_and_points(duo, recorder):
+    sc, rigs, (a, b) = duo
     sc.frame_set(11)                       # take sample 10 for both bodies
     source_overlay._draw()
     assert getattr(source_overlay._draw, "last_error", None) is None or recorder.draws
@@ -177,8 +161,8 @@ def test_the_draw_callback_draws_each_performer_as_lines_and_points(scene, recor
                               "program_point_size": False}                      # everything put back
 
 
-def test_the_draw_callback_survives_no_armature_no_take_and_a_gpu_error(scene, recorder, capsys):
-    sc, (alice, bob), _ = scene
+def test_the_draw_callback_survives_no_armature_no_take_and_a_gpu_error(duo, recorder):
+    sc, (alice, bob), _ = duo
     s = sc.kinect_retarget
     sc.frame_set(-500)                     # before the take: its first frame, not an error
     source_overlay._draw()
@@ -196,7 +180,7 @@ def test_the_draw_callback_survives_no_armature_no_take_and_a_gpu_error(scene, r
     assert recorder.state["blend"] == "MULTIPLY" and recorder.state["depth"] == "LESS_EQUAL"
 
 
-def test_a_gpu_failure_is_reported_once_and_the_state_put_back(scene, recorder, capsys, monkeypatch):
+def test_a_gpu_failure_is_reported_once_and_the_state_put_back(duo, recorder, capsys, monkeypatch):
     gpu = sys.modules["gpu"]
 
     def broken(name, config="DEFAULT"):
