@@ -198,3 +198,36 @@ def _angle(r0, r1):
     """(F,) degrees between two stacks of rotation matrices."""
     rel = np.swapaxes(r0, -1, -2) @ r1
     return np.degrees(np.arccos(np.clip((np.trace(rel, axis1=-2, axis2=-1) - 1) / 2, -1, 1)))
+
+
+def test_needed_pitch_is_the_smallest_turn_up_that_clears_the_floor(rng):
+    """The closed form against a brute-force search over turns: at the returned turn every tip is on or above
+    the floor, and no smaller turn up (on a 0.02-degree grid) is; feet already clear get 0. The room an ease
+    may use never sinks a tip."""
+    from kinect_retarget.core.quat import to_matrix
+    from kinect_retarget.core.toe_floor import axis_angle_quats, needed_pitch, pitch_room
+    n, k = 200, 3
+    ankle = rng.normal(0, 0.05, (n, 3)) + [0, 0, 0.1]
+    tip = ankle[:, None] + rng.normal(0, 0.12, (n, k, 3))
+    axis = rng.normal(0, 1, (n, 3)) * [1, 1, 0]
+    axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
+    need = needed_pitch(ankle, tip, axis, UP, 0.0)
+
+    def lowest(t):
+        r = to_matrix(axis_angle_quats(axis, t))
+        return (ankle[:, None] + np.einsum("fij,fkj->fki", r, tip - ankle[:, None]))[..., 2].min(axis=1)
+
+    grid = np.radians(np.arange(0, 360, 0.02))
+    first = np.full(n, np.inf)
+    for t in grid[::-1]:
+        ok = lowest(np.full(n, t)) >= 0
+        first[ok] = t
+    reachable = np.isfinite(first)                               # some turn up clears every tip
+    clear = tip[..., 2].min(axis=1) >= 0
+    assert np.all(need[clear] == 0) and (reachable & ~clear).sum() > 25
+    assert np.all(lowest(need)[reachable] >= -1e-9)
+    np.testing.assert_allclose(need[reachable], first[reachable], atol=np.radians(0.021))
+    room = pitch_room(ankle, tip, axis, UP, 0.0, need)
+    for frac in (0.25, 0.5, 1.0):
+        t = need + frac * (np.minimum(room, need + np.pi) - need)
+        assert np.all(lowest(t)[reachable] >= -1e-9)
