@@ -5,7 +5,11 @@
 1. feet_before_after.png: MakeHuman's default skeleton (CC0) walking (CMU 131_02, sample_takes), side view of
    one stance of the left foot: the leg at the stance's start, middle and end and the ankle's path during the
    stance (red: as retargeted, sliding; green: with the feet locked).
-2. structure_mapping.png: Blender's human metarig with every bone renamed to a random string, mapped by
+2. toes_before_after.png: Unreal's UE4 bone layout walking with its feet turned 40 degrees further down than
+   the performer's (tests/takes/steep_feet.py), side view of the left shin, foot and ball at the frame whose
+   toes dip deepest (left: as retargeted, the toes under the floor; right: with the feet locked, the foot
+   pitched up about the ankle).
+3. structure_mapping.png: Blender's human metarig with every bone renamed to a random string, mapped by
    structure alone: the bones that drive a Kinect segment coloured (spine blue, left green, right red), the
    rest (face, fingers, palms, heels, breasts) grey.
 """
@@ -25,7 +29,8 @@ sys.path.insert(0, str(REPO / "tools"))
 import bpy  # noqa: E402
 from make_autorig_pictures import markers, material, sticks  # noqa: E402
 
-from kinect_retarget.blender.io.workbench_render import contact_sheet, render_still, stage  # noqa: E402
+from kinect_retarget.blender.io.workbench_render import (  # noqa: E402
+    contact_sheet, frame_camera, render_still, setup_workbench, stage)
 from kinect_retarget.core.armature_mapping import structure_mapping_for  # noqa: E402
 from kinect_retarget.core.foot_contacts import intervals  # noqa: E402
 from kinect_retarget.core.foot_lock import FootLock  # noqa: E402
@@ -82,6 +87,46 @@ def feet_pictures() -> str:
     return contact_sheet(paths, str(HERE / "feet_before_after.png"), step=1)
 
 
+def toe_pictures() -> str:
+    from kinect_retarget.core.toe_floor import tips
+    from tests.rigs.humanoid_rigs import build
+    from tests.rigs.layouts import LAYOUTS
+    from tests.takes.steep_feet import steep_feet
+    take = steep_feet(load_take(REPO / "sample_takes" / "kinect_v1_cmu_131_02_walk.krtake"))
+    rig = build(LAYOUTS["ue4-mannequin"], a_pose_deg=30).target("UE4")
+    pipe = RetargetPipeline(take.skeleton, rig, PRESETS["ue4-mannequin"], RetargetSettings())
+    before = pipe.process_take(take)
+    after = copy.deepcopy(before)
+    lock = FootLock(pipe.retargeter)
+    report = lock.apply(after, "lock", take.rate)
+    legs = [rig.index(n) for n in ("calf_l", "foot_l", "ball_l")]
+    toes = [rig.index(n) for n in ("foot_l", "ball_l")]
+    shift = report.height_shift_cm / 100
+    p0 = _posed(rig, before)
+    p0[:, :, 2, 3] += shift  # the same body height in both pictures
+    f = int(np.argmin(tips(rig, p0, toes)[..., 2].min(axis=1)))
+    sticks_at = {}
+    for label, posed in (("before", p0), ("after", _posed(rig, after))):
+        heads = posed[f, legs, :3, 3]
+        sticks_at[label] = heads, heads + posed[f, legs, :3, 1] * rig.lengths[legs, None]
+    ends = np.concatenate([np.concatenate(v) for v in sticks_at.values()])
+    lo, hi = ends.min(axis=0), ends.max(axis=0)
+    lo[2] = min(lo[2], lock.floor)
+    paths = []
+    for label, (heads, tails) in sticks_at.items():
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        scene = bpy.context.scene
+        sticks(heads, tails, 0.006, material("leg", (0.35, 0.35, 0.4, 1)), "leg")
+        x = (lo[0] + hi[0]) / 2  # the floor seen edge-on: a red line at the rig's floor across the view
+        sticks(np.array([[x, lo[1] - 0.15, lock.floor]]), np.array([[x, hi[1] + 0.15, lock.floor]]), 0.003,
+               material("floor", (0.85, 0.15, 0.1, 1)), "floor")
+        depth = 100 * max(0.0, lock.floor - float(tails[1:, 2].min()))
+        setup_workbench(scene, (480, 360), f"{label}: toes {depth:.1f} cm under the floor (red)")
+        frame_camera(scene, lo - [0, 0.15, 0.05], hi + [0, 0.15, 0], azimuth_deg=90, elevation_deg=0)
+        paths.append(render_still(scene, str(HERE / f"toes_{label}.png"), 1))
+    return contact_sheet(paths, str(HERE / "toes_before_after.png"), step=1)
+
+
 def structure_picture() -> str:
     import addon_utils
     bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -119,4 +164,5 @@ def structure_picture() -> str:
 
 if __name__ == "__main__":
     print(feet_pictures())
+    print(toe_pictures())
     print(structure_picture())
