@@ -270,22 +270,28 @@ def _live_error_while_moving(obj, c, src, take, frames) -> list[float]:
     return moving
 
 
-def test_live_on_rigify_is_exact_while_moving(registered, rigify_rig_path):
+@pytest.mark.parametrize("renamed", [False, True], ids=["rigify", "renamed-structure"])
+def test_live_on_rigify_is_exact_while_moving(registered, rigify_rig_path, renamed):
     """Rigify's FK controls hang from constrained MCH bones: live uses the relations the probe learned at
-    start, so every live pose is exact from the first frame, moving or not, without evaluating Blender."""
+    start, so every live pose is exact from the first frame, moving or not, without evaluating Blender. So
+    it is with every bone renamed, mapped by structure (the limbs switched to FK through their drivers)."""
     from kinect_retarget.takes import load_take
+    from tests.rigs.control_rigs import rename_bones
 
     bpy.ops.wm.open_mainfile(filepath=str(rigify_rig_path))
     obj = bpy.data.objects["rig"]
+    back = rename_bones(obj, 12) if renamed else {}
     take = load_take(REPO_SAMPLE)
     s = bpy.context.scene.kinect_retarget
-    s.initialised, s.armature, s.preset, s.filter = True, obj, "rigify", "none"
+    s.initialised, s.armature, s.preset, s.filter = True, obj, "auto" if renamed else "rigify", "none"
     s.hands = "off"  # the hands roll the hand bones off the retarget's desired rotation on purpose (test_hands)
     src = _Manual(take.skeleton, 30.0)
     scenes = len(bpy.data.scenes)
     c = live.start_live(bpy.context, source=src, use_timer=False)
     assert c.model is not None and c.model.fallback == () and not c.exact and not c.update_after_apply
     assert len(bpy.data.scenes) == scenes   # the probe's armature copy and its scene are gone
+    if renamed:
+        assert {back[b] for b in c.session.pipeline.bone_names} >= {"torso", "chest", "upper_arm_fk.L", "shin_fk.R"}
     moving = _live_error_while_moving(obj, c, src, take, range(61, 121))
     live.stop_live(bake=False)
     assert len(moving) == 60 and max(moving) < 0.001
