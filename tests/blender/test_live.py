@@ -292,6 +292,8 @@ def test_live_on_rigify_is_exact_while_moving(registered, rigify_rig_path, renam
     assert len(bpy.data.scenes) == scenes   # the probe's armature copy and its scene are gone
     if renamed:
         assert {back[b] for b in c.session.pipeline.bone_names} >= {"torso", "chest", "upper_arm_fk.L", "shin_fk.R"}
+        switches = [b for b, old in back.items() if old in ("upper_arm_parent.L", "thigh_parent.R")]
+        assert [obj.pose.bones[b]["IK_FK"] for b in switches] == [1.0, 1.0]   # switched to FK while live
     moving = _live_error_while_moving(obj, c, src, take, range(61, 121))
     live.stop_live(bake=False)
     assert len(moving) == 60 and max(moving) < 0.001
