@@ -1,7 +1,8 @@
 """The generated Rigify control rig (706 bones: FK and IK controls, ORG/DEF/MCH chains, tweak bones) with every
 bone renamed to a random string in Blender (constraints and drivers follow the new names) maps by structure
-exactly as the 'rigify' preset maps the original (core/control_rig_mapping.py), `info --rig` prints it, the
-sidebar fills its table with it, and a take baked onto the renamed rig equals the bake onto the original."""
+exactly as the 'rigify' preset maps the original (core/control_rig_mapping.py), also generated from a T-posed
+metarig and from the Basic Human metarig; `info --rig` prints it, the sidebar fills its table with it, and a
+take baked onto the renamed rig equals the bake onto the original."""
 import json
 import subprocess
 import sys
@@ -80,6 +81,25 @@ def test_rigify_rig_generated_in_a_t_pose_renamed_maps_as_its_preset(bpy_empty, 
     rig = target_rig_from_object(obj)
     used, mapping = build_mapping("auto", rig.bone_names, None, rig)
     assert used == "structure" and {back[b]: j for b, j in mapping.items()} == PRESETS["rigify"]
+
+
+def test_rigify_rig_generated_from_the_basic_human_renamed_maps_as_its_preset(bpy_empty):
+    """Rigify's other human metarig (Basic Human: no face, no fingers; 222 generated bones)."""
+    import addon_utils
+
+    from kinect_retarget.blender.io.rig_reader import fk_switch_bones, target_rig_from_object
+    bpy = bpy_empty
+    addon_utils.enable("rigify", default_set=True)
+    bpy.ops.object.armature_basic_human_metarig_add()
+    meta = bpy.context.object
+    bpy.ops.pose.rigify_generate()
+    obj = next(o for o in bpy.data.objects if o.type == "ARMATURE" and o != meta)
+    assert len(obj.data.bones) == 222
+    back = rename_bones(obj, 8)
+    rig = target_rig_from_object(obj)
+    used, mapping = build_mapping("auto", rig.bone_names, None, rig)
+    assert used == "structure" and {back[b]: j for b, j in mapping.items()} == PRESETS["rigify"]
+    assert sorted(back[b] for b in fk_switch_bones(obj)) == sorted(RIGIFY_FK_SWITCHES)
 
 
 def test_sidebar_fills_the_table_of_the_renamed_control_rig(registered, rigify_rig_path):
