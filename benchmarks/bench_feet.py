@@ -1,7 +1,8 @@
 """Planted feet (issue 16): foot slide during detected contacts and floor penetration before and after the
-feet pass (core/foot_lock.py), and how much the limbs' directions change where it does not act, on every
-sample take with walking, hopping or jumping and on the Kinect v2 gestures, baked onto the generated Kinect
-rig and onto MakeHuman's default skeleton (a real third-party rig with twist bones).
+feet pass (core/foot_lock.py, core/toe_floor.py) for the ankles and the toe tips, and how much the limbs'
+directions change where it does not act, on every sample take with walking, hopping or jumping and on the
+Kinect v2 gestures, baked onto the generated Kinect rig, MakeHuman's default skeleton (a real third-party rig
+with twist bones and fifteen toe bones) and Unreal's UE4 bone layout (a ball bone under each foot).
 
     .venv/bin/python benchmarks/bench_feet.py
 
