@@ -53,17 +53,9 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-def test_live_osc_receives_ni_mate_frames_and_skips_garbage(tmp_path):
-    port = _free_port()
-    take = krtake.read(SAMPLE)
-    names = {"Head": "Head", "Neck": "Neck", "Torso": "SpineMid", "Left_Shoulder": "ShoulderLeft",
-             "Left_Elbow": "ElbowLeft", "Left_Hand": "HandLeft", "Right_Shoulder": "ShoulderRight",
-             "Right_Elbow": "ElbowRight", "Right_Hand": "HandRight", "Left_Hip": "HipLeft",
-             "Left_Knee": "KneeLeft", "Left_Foot": "FootLeft", "Right_Hip": "HipRight",
-             "Right_Knee": "KneeRight", "Right_Foot": "FootRight"}
-    idx = {n: take.skeleton.index(j) for n, j in names.items()}
-    stop = threading.Event()
-
+def _send_when_listening(port: int, frames: list[list[bytes]], stop: threading.Event) -> threading.Thread:
+    """A thread that waits for the live command to hold `port` (Blender start-up), then sends each frame's
+    packets, 30 frames a second."""
     def listening() -> bool:
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
             try:
@@ -75,21 +67,35 @@ def test_live_osc_receives_ni_mate_frames_and_skips_garbage(tmp_path):
     def sender():
         end = time.perf_counter() + 60
         while not listening() and not stop.is_set() and time.perf_counter() < end:
-            time.sleep(0.2)  # Blender start-up
+            time.sleep(0.2)
         time.sleep(0.2)
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-            for i in range(40):
+            for packets in frames:
                 if stop.is_set():
                     return
-                if i == 20:
-                    s.sendto(b"garbage!", ("127.0.0.1", port))  # skipped and counted, live goes on
-                for n, j in idx.items():
-                    s.sendto(encode_message("/" + n, *map(float, take.positions[i, j])), ("127.0.0.1", port))
-                s.sendto(encode_message("/NI_mate_sync", "x"), ("127.0.0.1", port))
+                for packet in packets:
+                    s.sendto(packet, ("127.0.0.1", port))
                 time.sleep(1 / 30)
 
     t = threading.Thread(target=sender)
     t.start()
+    return t
+
+
+def test_live_osc_receives_ni_mate_frames_and_skips_garbage(tmp_path):
+    port = _free_port()
+    take = krtake.read(SAMPLE)
+    names = {"Head": "Head", "Neck": "Neck", "Torso": "SpineMid", "Left_Shoulder": "ShoulderLeft",
+             "Left_Elbow": "ElbowLeft", "Left_Hand": "HandLeft", "Right_Shoulder": "ShoulderRight",
+             "Right_Elbow": "ElbowRight", "Right_Hand": "HandRight", "Left_Hip": "HipLeft",
+             "Left_Knee": "KneeLeft", "Left_Foot": "FootLeft", "Right_Hip": "HipRight",
+             "Right_Knee": "KneeRight", "Right_Foot": "FootRight"}
+    idx = {n: take.skeleton.index(j) for n, j in names.items()}
+    frames = [([b"garbage!"] if i == 20 else [])  # skipped and counted, live goes on
+              + [encode_message("/" + n, *map(float, take.positions[i, j])) for n, j in idx.items()]
+              + [encode_message("/NI_mate_sync", "x")] for i in range(40)]
+    stop = threading.Event()
+    t = _send_when_listening(port, frames, stop)
     try:
         rec = tmp_path / "osc.krtake"
         proc = run_cli("--source", f"osc:{port}", "--seconds", "10", "--record", str(rec))
@@ -103,6 +109,37 @@ def test_live_osc_receives_ni_mate_frames_and_skips_garbage(tmp_path):
     kept = krtake.read(rec)
     assert kept.frame_count == 40  # every frame, before and after the garbage
     np.testing.assert_allclose(kept.positions[0, idx["Left_Hand"]], take.positions[0, idx["Left_Hand"]], atol=1e-5)
+
+
+def test_live_osc_with_two_users_drives_a_rig_each(tmp_path, data_dir):
+    """NI mate numbering its users (`/Joint_1`, `/Joint_2`): `live --body 0 --body 1` drives a generated rig
+    per user from the command line, records each user to its own file and bakes each onto its rig."""
+    from tests.takes.two_performers import performers
+    port = _free_port()
+    first, second = performers(data_dir)
+    joints = first.skeleton.joints
+    frames = [[encode_message(f"/{name}_{user}", *map(float, take.positions[i, j]))
+               for user, take in ((1, first), (2, second)) for j, name in enumerate(joints)]
+              + [encode_message("/NI_mate_sync", "x")] for i in range(30)]
+    stop = threading.Event()
+    t = _send_when_listening(port, frames, stop)
+    try:
+        rec, out = tmp_path / "duo.krtake", tmp_path / "duo.blend"
+        proc = run_cli("--source", f"osc:{port}", "--seconds", "10", "--body", "0", "--body", "1",
+                       "--filter", "none", "--record", str(rec), "--out", str(out))
+    finally:
+        stop.set()
+        t.join()
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    result = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert [(p["armature"], p["body"]) for p in result["performers"]] == [("KinectRig_body0", 0),
+                                                                          ("KinectRig_body1", 1)]
+    assert all(p["action"] and p["applied"] > 0 and p["error"] is None for p in result["performers"])
+    for path, take in ((rec, first), (tmp_path / "duo_body1.krtake", second)):  # each user on its own
+        kept = krtake.read(path)
+        assert kept.frame_count == 30
+        np.testing.assert_allclose(kept.positions[-1], take.positions[29], atol=2e-5)
+    assert out.is_file()
 
 
 def test_live_unknown_preset_or_filter_is_a_usage_error_not_a_traceback():
