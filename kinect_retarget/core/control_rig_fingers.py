@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .control_rig_mapping import COINCIDE, RigLinks, _near, deform_parents, is_control_rig
+from .control_rig_mapping import COINCIDE, RigLinks, deform_parents, is_control_rig, near
 
 FINGER_BONES = 3   # bones per finger chain (hand_pose bends the first and curls all three)
 
@@ -42,7 +42,7 @@ def finger_chains_by_structure(parents, heads, tails, links: RigLinks | None, ha
     if links is None or not is_control_rig(parents, links):
         return None   # other rigs' fingers are found by name (hand_pose.FINGER_NAMES)
     tree = deform_parents(parents, heads, tails, links, tol)
-    twin = [d for d in tree if _near(heads[d], heads[hand], tol) and _near(tails[d], tails[hand], tol)]
+    twin = [d for d in tree if near(heads[d], heads[hand], tol) and near(tails[d], tails[hand], tol)]
     if not twin:
         return None
     root = twin[0]
@@ -62,7 +62,7 @@ def finger_chains_by_structure(parents, heads, tails, links: RigLinks | None, ha
     spans = {}
     for chain in out.values():
         for d in chain:
-            at = controls[_near(heads[controls], heads[d], tol) & _near(tails[controls], tails[d], tol)]
+            at = controls[near(heads[controls], heads[d], tol) & near(tails[controls], tails[d], tol)]
             if not len(at):
                 return None
             spans[d] = int(at[0])

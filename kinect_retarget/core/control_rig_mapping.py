@@ -74,7 +74,8 @@ def map_armature(bone_names, parents, heads, tails, links: RigLinks | None = Non
     return structure_mapping_for(bone_names, parents, heads, tails)
 
 
-def _near(a, b, tol) -> np.ndarray:
+def near(a, b, tol) -> np.ndarray:
+    """Which points of a (..., 3) lie within tol of b."""
     return np.linalg.norm(np.asarray(a) - np.asarray(b), axis=-1) < tol
 
 
@@ -90,7 +91,7 @@ def deform_parents(parents, heads, tails, links: RigLinks, tol: float) -> dict[i
             if links.deform[a]:
                 out[int(d)] = a
                 break
-            twins = deform[_near(heads[deform], heads[a], tol) & _near(tails[deform], tails[a], tol)]
+            twins = deform[near(heads[deform], heads[a], tol) & near(tails[deform], tails[a], tol)]
             twins = twins[twins != d]
             if len(twins):
                 out[int(d)] = int(twins[0])
@@ -182,8 +183,8 @@ def control_rig_mapping(bone_names, parents, heads, tails, links: RigLinks) -> A
         d = bone_of[joint]
         base, side = _split(joint)
         ends = [tails[d]] + ([heads[bone_of[NEXT[base] + side]]] if NEXT.get(base, "") + side in bone_of else [])
-        at = controls[_near(heads[controls], heads[d], tol)]
-        return [int(c) for c in at if any(_near(tails[c], e, tol) for e in ends) and c not in in_ik]
+        at = controls[near(heads[controls], heads[d], tol)]
+        return [int(c) for c in at if any(near(tails[c], e, tol) for e in ends) and c not in in_ik]
 
     found: dict[str, list[int]] = {}
     for joint in bone_of:
