@@ -90,13 +90,15 @@ def fanout(m, j: int) -> int:
 
 
 def big_branches(m, j: int, frac: float) -> list[int]:
-    """Children of j reaching at least frac of the figure; in an armature, a zero-length child's own
-    branches count in its place (Daz's legs hang from a pelvis bone that starts where the hip bone does)."""
+    """Children of j reaching at least frac of the figure, by the length of their long bones or, failing that,
+    in a straight line (a neck of two short bones under a head whose face bones hide its length reaches
+    the top of the head all the same); in an armature, a zero-length child's own branches count in its place
+    (Daz's legs hang from a pelvis bone that starts where the hip bone does)."""
     out = []
     for c in m.kids[j]:
         if m.armature and m.kids[c] and m.seg[c] < m.short * m.size:
             out += big_branches(m, c, frac)
-        elif m.bulk[c] + m.long[c] >= frac * m.size:
+        elif max(m.bulk[c] + m.long[c], m._extent(j, c)) >= frac * m.size:
             out.append(c)
     return out
 

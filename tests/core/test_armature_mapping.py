@@ -21,7 +21,8 @@ from kinect_retarget.takes import load_take
 from tests.rigs.humanoid_rigs import Rig, build, from_target, makehuman_rig, renamed
 from tests.rigs.layouts import LAYOUTS
 
-VARIANTS = {"t-pose": {}, "a-pose+face": {"a_pose_deg": 40, "face": True}, "no-fingers": {"fingers": False},
+VARIANTS = {"t-pose": {}, "t-pose+face": {"face": True}, "a-pose+face": {"a_pose_deg": 40, "face": True},
+            "no-fingers": {"fingers": False},
             "a-pose-30-no-fingers": {"a_pose_deg": 30, "fingers": False}}
 
 
@@ -114,14 +115,18 @@ def test_take_baked_by_structure_follows_the_performer(family, hop):
         assert err.max() < 1e-3, (family, m.bone, m.tail_name)
 
 
-def _hanim_rig() -> Rig:
+def _hanim_rig(vc4: bool = False) -> Rig:
     """A small H-Anim humanoid (bones named after the joint at their head), with the standard's hierarchy
     (ISO/IEC 19774, LOA 2+, intermediate vertebrae left out as the standard allows): vl5 -> vt1 -> skullbase, and
-    the sternoclavicular joints hang from vt1 (the test armature in tests/blender/test_lift_clip.py likewise)."""
+    the sternoclavicular joints hang from vt1 (the test armature in tests/blender/test_lift_clip.py likewise).
+    With vc4 the neck is two short bones, vt1 -> vc4 -> skullbase, each about 6 cm."""
     from tests.rigs.humanoid_rigs import ANKLE, BALL, CLAV, ELBOW, HIP, HIPS, KNEE, KNUCKLE, NECK_BASE, \
         SHOULDER, SKULL, TOP, WRIST
     bones = [("sacroiliac", None, HIPS, (0, 0, 1.2)), ("vl5", "sacroiliac", (0, 0, 1.2), NECK_BASE),
              ("vt1", "vl5", NECK_BASE, SKULL), ("skullbase", "vt1", SKULL, TOP)]
+    if vc4:
+        mid = tuple((np.array(NECK_BASE) + np.array(SKULL)) / 2)
+        bones[2:] = [("vt1", "vl5", NECK_BASE, mid), ("vc4", "vt1", mid, SKULL), ("skullbase", "vc4", SKULL, TOP)]
     for s, x in (("l_", 1.0), ("r_", -1.0)):
         m = lambda p: (p[0] * x, p[1], p[2])  # noqa: E731
         bones += [(f"{s}sternoclavicular", "vt1", m(CLAV), m(SHOULDER)),
@@ -134,8 +139,9 @@ def _hanim_rig() -> Rig:
     return Rig(names, parents, np.array([b[2] for b in bones], float), np.array([b[3] for b in bones], float))
 
 
+@pytest.mark.parametrize("vc4", [False, True], ids=["neck-vt1", "neck-vt1-vc4"])
 @pytest.mark.parametrize("seed", [1, 2])
-def test_hanim_armature_renamed_maps_as_its_preset(seed):
-    rig = _hanim_rig()
+def test_hanim_armature_renamed_maps_as_its_preset(seed, vc4):
+    rig = _hanim_rig(vc4)
     assert detect_preset(rig.names) == "hanim"
     assert _by_structure(rig, seed) == _preset(rig, "hanim")
