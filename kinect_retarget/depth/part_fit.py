@@ -38,9 +38,20 @@ PROMOTE = False             # a joint moved to a confident proposal is reported 
 HANDS = True                # the hand from its own proposal (else along the forearm from the wrist)
 AGREE = 0.10                # a tracked joint moved farther than this (m) by a proposal is reported inferred
 MAX_MOVE = 0.35             # m a proposal may move its joint from the fit (farther: another part mistaken)
-ARM_REACH = False           # an arm joint the fit doubts may move farther, within the arm's reach of its shoulder
+ARM_REACH = True            # an arm joint the fit doubts may move farther, within the arm's reach of its shoulder
+# The Kinect SDK's conventions, measured on its own skeletons (Kinect v2, redistributable: tools/
+# measure_sdk_proportions.py), fractions of standing height: its hand joint sits this far beyond the wrist
+# (MakeHuman's 0.056), its ankle this far above and behind its foot joint (MakeHuman's foot is the toes' base)
+SDK_HAND = 0.037
+SDK_ANKLE_ABOVE_FOOT, SDK_ANKLE_BEHIND_FOOT = 0.041, 0.041
+WRIST_BEFORE_HAND = SDK_HAND
+ANKLE_FROM_FOOT = True         # without a floor, the ankle where the SDK puts it relative to the proposed foot   # the wrist of a proposed hand sits this far before it (fraction of height)
+FEET_TRACKED = False        # without a floor, a foot on a confident proposal (TRACK_CONFIDENCE) is reported tracked
 FEET_APART = 0.08           # m: foot proposals nearer each other than this are one foot seen twice
 NO_OFFSET = ("AnkleLeft", "AnkleRight", "FootLeft", "FootRight")   # proposals used as found (see below)
+DISAGREE = 0.15             # m from a confident proposal beyond which a joint is reported inferred
+# joints whose proposals check the fit's states (hips and knees: their parts sat 20-25 cm low on real legs)
+CHECKED = np.array([not n.startswith(("Hip", "Knee", "Spine")) for n in KINECT_V1.joints])
 OUTWARD = np.array([1.0 if "Left" in n else -1.0 if "Right" in n else 0.0 for n in KINECT_V1.joints])
 
 
@@ -126,10 +137,11 @@ def _arm_direct(pos, st, p, conf, use, s, height) -> None:
         pos[el], st[el] = p[el], _state(conf[el])
     if use[ha]:
         pos[ha], st[ha] = p[ha], _state(conf[ha])
-        pos[wr], st[wr] = pos[ha] - _unit(pos[ha] - pos[el]) * bm.HAND * height, _state(min(conf[el], conf[ha]))
+        pos[wr] = pos[ha] - _unit(pos[ha] - pos[el]) * WRIST_BEFORE_HAND * height
+        st[wr] = _state(min(conf[el], conf[ha]))
 
 
-def _foot(pos, st, p, conf, in_view, s, height, frame) -> None:
+def _foot(pos, st, p, conf, in_view, s, height, frame) -> bool:
     """The foot from its proposal, the ankle moved with it and the knee re-solved between hip and ankle. The
     fit's feet are no gate here (without a floor they are the least sure part of it: a third of its real feet
     lay more than 35 cm off, or nearer the other foot): the two foot proposals must be apart, within the leg's
@@ -144,18 +156,21 @@ def _foot(pos, st, p, conf, in_view, s, height, frame) -> None:
           np.ndim(in_view) else in_view) and np.linalg.norm(apart) > FEET_APART
           and np.linalg.norm(p[ft] - pos[hip]) < reach and (frame is None or side * (apart @ frame[0]) > -0.05))
     if not ok:
-        return
+        return False
     delta = p[ft] - pos[ft]
     pos[an], pos[ft] = pos[an] + delta, p[ft]
     cands, _ = two_bone_candidates(pos[hip], pos[an], bm.THIGH * height, bm.SHIN * height)
     guess = pos[kn] + 0.5 * delta
     pos[kn] = cands[int(np.argmin(np.linalg.norm(cands - guess, axis=1)))]
+    if frame is not None and ANKLE_FROM_FOOT:   # (the knee was solved with the body's own shin)
+        pos[an] = p[ft] + (SDK_ANKLE_ABOVE_FOOT * frame[1] - SDK_ANKLE_BEHIND_FOOT * frame[2]) * height
     if FEET:
         st[ft], st[an] = _state(conf[ft]), _state(conf[ft])
+    return True
 
 
 def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_floor: bool = False,
-                    in_view=True, frame: np.ndarray | None = None, turned: bool = False) -> None:
+                    in_view=True, frame: np.ndarray | None = None, turned: bool = False) -> np.ndarray:
     """Move joints to confident proposals, in place (positions (20, 3), states (20,)). `frame`: the body's
     frame (body_frame) for the learned offsets (None: proposals stand for their joints as found).
     `no_floor`: no floor was found, so nothing removed what lies below the feet (a pre-segmented frame keeps
@@ -163,7 +178,9 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
     the fit says. `in_view` ((20,) bool): joints the fit placed inside the image (one continued past its edge
     keeps its place: the part seen at the edge is not its end). `turned`: the performer is turned well away
     from the sensor, where the forest confuses the arms' sides (the synthetic hop's 55 degree turn swapped the
-    hands): arms then move as a chain, only where the fit doubts them."""
+    hands): arms then move as a chain, only where the fit doubts them. Returns (20,) bool: joints not to be
+    reported tracked though the fit's history keeps its states (wrist and hand beyond an elbow the proposal
+    moved: the fit's arm was elsewhere)."""
     conf, p = props.confidence, joint_positions(props, frame)
     chain = ARMS == "chain" or turned
     use = _usable(conf, p, pos, st, no_floor, in_view, chain, height)
@@ -172,12 +189,36 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
         j = J(name)
         if use[j]:
             pos[j], st[j] = p[j], _state(conf[j])
+    feet: list[int] = []
     for s in SIDES:
         (_arm_chain if chain else _arm_direct)(pos, st, p, conf, use, s, height)
-        if FEET or no_floor:
-            _foot(pos, st, p, conf, in_view, s, height, frame)
+        if (FEET or no_floor) and _foot(pos, st, p, conf, in_view, s, height, frame):
+            feet.append(J(f"Foot{s}"))
     # the fit's tracked joints stay tracked where the proposal agrees with them
     moved = np.linalg.norm(pos - before, axis=1)
     st[(before_st == TRACKED) & (moved <= AGREE)] = TRACKED
     if not PROMOTE:
         st[(before_st == TRACKED) & (moved > AGREE)] = INFERRED
+    if FEET_TRACKED:   # both feet's parts seen apart and within the legs' reach: as sure as the SDK's feet
+        st[[f for f in feet if conf[f] >= TRACK_CONFIDENCE]] = TRACKED
+    if not chain:   # a wrist placed from its hand and elbow is no surer than they are
+        for s in SIDES:
+            el, wr, ha = (J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand"))
+            if use[ha]:
+                st[wr] = min(st[wr], st[el], st[ha])
+    doubt = np.zeros(20, bool)
+    for s in SIDES:
+        if moved[J(f"Elbow{s}")] > AGREE:
+            doubt[[J(f"Wrist{s}"), J(f"Hand{s}")]] = True
+    return doubt
+
+
+def disagreeing(pos: np.ndarray, props, frame: np.ndarray | None) -> np.ndarray:
+    """(20,) bool: joints left far from a confident proposal of their own part (the fit's evidence and the
+    forest's disagree: not to be reported tracked); a wrist goes with its hand. For the reported states only:
+    the fit's own states carry its history (fed back, this demotion swapped the synthetic hop's hands)."""
+    p = joint_positions(props, frame)
+    far = (props.confidence >= USE_CONFIDENCE) & (np.linalg.norm(pos - p, axis=1) > DISAGREE)
+    for s in SIDES:
+        far[J(f"Wrist{s}")] |= far[J(f"Hand{s}")]
+    return far & CHECKED

@@ -13,12 +13,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.skeletons import KINECT_V1
+from ..core.skeletons import INFERRED, KINECT_V1, TRACKED
 from ..core.take import Take
 from .body_model_fit import BodyCalibration
 from .depth_camera import DepthCamera
 from .confidence import ConfidenceCheck
-from .part_fit import apply_proposals, body_frame
+from .part_fit import apply_proposals, body_frame, disagreeing
 from .part_forest import MODEL_PATH, load_forest
 from .part_proposals import propose
 from .segmentation import DepthGrid, FloorPlane, PersonMask, find_people, fit_floor
@@ -116,10 +116,13 @@ class SkeletonTracker:
             self.last_proposals = propose(self.forest, grid, person.mask)
             rc = grid.to_pixel(fit.positions)   # a limb the fit continued past the image's edge keeps its end
             in_view = np.all((rc >= 0) & (rc < np.array(grid.z.shape) - 1), axis=1)
-            apply_proposals(fit.positions, fit.states, self.last_proposals, self.calibration.height,
+            doubt = apply_proposals(fit.positions, fit.states, self.last_proposals, self.calibration.height,
                             no_floor=self.floor is None, in_view=in_view,
                             frame=body_frame(fit.lateral, fit.axis), turned=fit.turned or fit.edge_on)
         pos, st = fit.positions, self.confidence.assess(fit.positions, fit.states, fit)
+        if self.forest is not None:   # reported states only (the fit's history keeps its own)
+            doubt |= disagreeing(pos, self.last_proposals, body_frame(fit.lateral, fit.axis))
+            st[doubt & (st == TRACKED)] = INFERRED
         self._calibrate(person, fit, up)
         if self._prev is not None and self.settings.smoothing > 0:
             step = np.linalg.norm(pos - self._prev, axis=1, keepdims=True)

@@ -81,7 +81,7 @@ def test_arms_take_proposals_directly_and_never_across_sides(no_offsets):
     # the wrist a hand's length before the hand, on the line from the elbow
     fore = pos[j("HandLeft")] - pos[j("ElbowLeft")]
     w = pos[j("WristLeft")] - pos[j("ElbowLeft")]
-    assert np.isclose(np.linalg.norm(pos[j("HandLeft")] - pos[j("WristLeft")]), part_fit.bm.HAND * 1.7)
+    assert np.isclose(np.linalg.norm(pos[j("HandLeft")] - pos[j("WristLeft")]), part_fit.WRIST_BEFORE_HAND * 1.7)
     assert np.isclose(w @ fore, np.linalg.norm(w) * np.linalg.norm(fore))
     # moved far from the fit's tracked joint: no longer claimed tracked
     assert st[j("ElbowLeft")] == INFERRED and st[j("HandLeft")] == INFERRED
@@ -111,8 +111,8 @@ def test_feet_without_a_floor_follow_their_proposals_and_refuse_one_foot_seen_tw
     p, s = fit.copy(), st.copy()
     part_fit.apply_proposals(p, s, props, 1.7, no_floor=True, frame=FACING)
     assert np.allclose(p[j("FootLeft")], pos[j("FootLeft")])
-    thigh, shin = (np.linalg.norm(p[j(a)] - p[j(b)]) for a, b in (("HipLeft", "KneeLeft"), ("KneeLeft", "AnkleLeft")))
-    assert np.isclose(thigh, part_fit.bm.THIGH * 1.7) and abs(shin - part_fit.bm.SHIN * 1.7) < 0.01
+    thigh = np.linalg.norm(p[j("HipLeft")] - p[j("KneeLeft")])   # the knee re-solved with the calibrated thigh
+    assert np.isclose(thigh, part_fit.bm.THIGH * 1.7)
     props.positions[j("FootLeft")] = props.positions[j("FootRight")] + [0.03, 0, 0]   # one foot, both labels
     p = fit.copy()
     part_fit.apply_proposals(p, st.copy(), props, 1.7, no_floor=True, frame=FACING)
@@ -138,3 +138,28 @@ def test_learned_offsets_bring_proposals_nearer_rendered_joints(rendered):
     raw, moved = np.concatenate(raw), np.concatenate(moved)
     assert len(raw) > 40
     assert moved.mean() < raw.mean() - 0.005 and moved.mean() < 0.06
+
+
+def test_ankle_sits_where_the_sdk_puts_it_above_and_behind_the_proposed_foot(no_offsets):
+    pos, st = _standing_pose()
+    p = pos.copy()
+    part_fit.apply_proposals(p, st.copy(), _proposals(pos), 1.7, no_floor=True, frame=FACING)
+    # facing the sensor, behind the foot is away from it (+Z)
+    expect = pos[j("FootLeft")] + np.array([0.0, part_fit.SDK_ANKLE_ABOVE_FOOT, part_fit.SDK_ANKLE_BEHIND_FOOT]) * 1.7
+    assert np.allclose(p[j("AnkleLeft")], expect)
+
+
+def test_joints_far_from_confident_proposals_are_not_reported_tracked(no_offsets):
+    pos, st = _standing_pose()
+    props = _proposals(pos)
+    props.positions[j("HandLeft")] += [0.0, 0.3, 0.0]    # the forest sees the hand 30 cm higher
+    props.positions[j("KneeLeft")] += [0.0, -0.3, 0.0]   # knee parts are not trusted to judge the fit
+    props.confidence[j("ElbowRight")] = 0.0              # no confident proposal: nothing to disagree with
+    props.positions[j("ElbowRight")] += [0.3, 0.0, 0.0]
+    far = part_fit.disagreeing(pos, props, FACING)
+    assert set(np.flatnonzero(far)) == {j("HandLeft"), j("WristLeft")}
+    # an elbow the proposal moved far: the fit's wrist and hand beyond it are not claimed tracked
+    props = _proposals(pos)
+    props.positions[j("ElbowLeft")] += [-0.2, 0.05, 0.0]
+    doubt = part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    assert set(np.flatnonzero(doubt)) == {j("HandLeft"), j("WristLeft")} and st[j("ElbowLeft")] == INFERRED
