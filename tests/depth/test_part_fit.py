@@ -115,8 +115,15 @@ def test_feet_without_a_floor_follow_their_proposals_and_refuse_one_foot_seen_tw
     assert np.isclose(thigh, part_fit.bm.THIGH * 1.7)
     props.positions[j("FootLeft")] = props.positions[j("FootRight")] + [0.03, 0, 0]   # one foot, both labels
     p = fit.copy()
-    part_fit.apply_proposals(p, st.copy(), props, 1.7, no_floor=True, frame=FACING)
-    assert np.array_equal(p[j("FootLeft")], fit[j("FootLeft")])
+    s = st.copy()
+    s[j("FootLeft")] = INFERRED
+    part_fit.apply_proposals(p, s, props, 1.7, no_floor=True, frame=FACING)
+    assert np.array_equal(p[j("FootLeft")], fit[j("FootLeft")]) and s[j("FootLeft")] == INFERRED
+    st_f = st.copy()
+    st_f[j("FootLeft")] = INFERRED
+    p = fit.copy()   # a confident foot proposal, apart from the other and in the leg's reach: tracked
+    part_fit.apply_proposals(p, st_f, _proposals(pos), 1.7, no_floor=True, frame=FACING)
+    assert st_f[j("FootLeft")] == TRACKED
     p = fit.copy()   # with a floor in view the fit's feet stand
     part_fit.apply_proposals(p, st.copy(), _proposals(pos), 1.7, no_floor=False, frame=FACING)
     assert np.array_equal(p[j("FootLeft")], fit[j("FootLeft")])
@@ -140,7 +147,8 @@ def test_learned_offsets_bring_proposals_nearer_rendered_joints(rendered):
     assert moved.mean() < raw.mean() - 0.005 and moved.mean() < 0.06
 
 
-def test_ankle_sits_where_the_sdk_puts_it_above_and_behind_the_proposed_foot(no_offsets):
+def test_ankle_sits_where_the_sdk_puts_it_above_and_behind_the_proposed_foot(no_offsets, monkeypatch):
+    monkeypatch.setattr(part_fit, "ANKLE_FROM_FOOT", True)
     pos, st = _standing_pose()
     p = pos.copy()
     part_fit.apply_proposals(p, st.copy(), _proposals(pos), 1.7, no_floor=True, frame=FACING)
