@@ -27,6 +27,7 @@ J = KINECT_V1.index
 SIDES = ("Left", "Right")
 OFFSETS_PATH = os.fspath(ASSETS_DIR / "part_joint_offsets.npz")
 USE_CONFIDENCE = 0.0006     # square metres of likely part around a proposal from which it is used
+DOUBTED_ARM_CONFIDENCE = 0.0003   # ... for an elbow or hand the fit doubts (direct arms)
 TRACK_CONFIDENCE = 0.0008   # ... and from which its joint is reported tracked (with PROMOTE)
 DIRECT: tuple[str, ...] = ("Head", "ShoulderCenter", "ShoulderLeft", "ShoulderRight")   # taken as proposed
 ARMS = "direct"             # "direct": elbows and hands as proposed; "chain": doubted arm joints as a chain
@@ -108,7 +109,11 @@ def _usable(conf, p, pos, st, no_floor: bool, in_view, chain: bool, height=None)
             for n, r in (("Elbow", bm.UPPER_ARM), ("Hand", bm.UPPER_ARM + bm.FOREARM + bm.HAND)):
                 k = J(f"{n}{s}")
                 near[k] |= st[k] != TRACKED and np.linalg.norm(p[k] - sh) < 1.15 * r * height + 0.05
-    ok = (conf >= USE_CONFIDENCE) & near & in_view
+    sure = conf >= USE_CONFIDENCE
+    if not chain:   # an arm the fit doubts: a less confident proposal is still the better guess
+        arms = np.array([n.startswith(("Elbow", "Hand")) for n in KINECT_V1.joints]) & (st != TRACKED)
+        sure |= arms & (conf >= DOUBTED_ARM_CONFIDENCE)
+    ok = sure & near & in_view
     if ONLY_INFERRED and chain:
         arms = [J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand") for s in SIDES]
         ok[arms] &= st[arms] != TRACKED

@@ -171,3 +171,15 @@ def test_joints_far_from_confident_proposals_are_not_reported_tracked(no_offsets
     props.positions[j("ElbowLeft")] += [-0.2, 0.05, 0.0]
     doubt = part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
     assert set(np.flatnonzero(doubt)) == {j("HandLeft"), j("WristLeft")} and st[j("ElbowLeft")] == INFERRED
+
+
+def test_a_doubted_arm_takes_a_less_confident_proposal(no_offsets):
+    pos, st = _standing_pose()
+    st[j("ElbowLeft")] = INFERRED
+    props = _proposals(pos, conf=0.5 * (part_fit.USE_CONFIDENCE + part_fit.DOUBTED_ARM_CONFIDENCE))
+    props.positions[j("ElbowLeft")] += [-0.1, 0.05, 0.0]
+    props.positions[j("ElbowRight")] += [0.1, 0.05, 0.0]    # the fit tracks this elbow: it stays
+    before = pos.copy()
+    part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    assert np.allclose(pos[j("ElbowLeft")], props.positions[j("ElbowLeft")])
+    assert np.array_equal(pos[j("ElbowRight")], before[j("ElbowRight")])
