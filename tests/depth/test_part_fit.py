@@ -183,3 +183,15 @@ def test_a_doubted_arm_takes_a_less_confident_proposal(no_offsets):
     part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
     assert np.allclose(pos[j("ElbowLeft")], props.positions[j("ElbowLeft")])
     assert np.array_equal(pos[j("ElbowRight")], before[j("ElbowRight")])
+
+
+def test_an_elbow_proposal_by_the_shoulder_is_refused(no_offsets):
+    """An elbow part seen next to the shoulder (a hand on the face folds the arm there) is not the elbow: it
+    must lie about an upper arm's length from the shoulder."""
+    pos, st = _standing_pose()
+    st[j("ElbowRight")] = INFERRED
+    props = _proposals(pos)
+    props.positions[j("ElbowRight")] = pos[j("ShoulderRight")] + [0.0, -0.15, -0.05]   # 0.68 upper arms away
+    before = pos.copy()
+    part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    assert np.array_equal(pos[j("ElbowRight")], before[j("ElbowRight")])
