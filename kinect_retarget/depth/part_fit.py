@@ -50,7 +50,7 @@ WRIST_BEFORE_HAND = SDK_HAND   # the wrist of a proposed hand sits this far befo
 # on the real benchmark's subjects 1-2 ankles 9.5 -> 7.5 cm but the shins' directions 1.6 degrees worse; off
 ANKLE_FROM_FOOT = False
 FEET_TRACKED = True         # without a floor, a foot on a confident proposal (TRACK_CONFIDENCE) is reported tracked
-ELBOW_REACH = (0.85, 1.45)  # elbow proposal to shoulder, in upper arms (the SDK's upper arm is 1.1-1.2 of ours)
+ELBOW_REACH = (0.85, 1.45)  # less confident elbow proposal to shoulder, in upper arms (the SDK's upper arm is 1.1-1.2 of ours)
 FEET_APART = 0.08           # m: foot proposals nearer each other than this are one foot seen twice
 NO_OFFSET = ("AnkleLeft", "AnkleRight", "FootLeft", "FootRight")   # proposals used as found (see below)
 DISAGREE = 0.15             # m from a confident proposal beyond which a joint is reported inferred
@@ -115,11 +115,11 @@ def _usable(conf, p, pos, st, no_floor: bool, in_view, chain: bool, height=None)
         arms = np.array([n.startswith(("Elbow", "Hand")) for n in KINECT_V1.joints]) & (st != TRACKED)
         sure |= arms & (conf >= DOUBTED_ARM_CONFIDENCE)
     ok = sure & near & in_view
-    if not chain:   # an elbow proposal about an upper arm's length from its shoulder (not a part seen near it)
-        for s in SIDES:
+    if not chain:   # a less confident elbow proposal lies about an upper arm from its shoulder (not a part
+        for s in SIDES:   # seen beside it)
             k = J(f"Elbow{s}")
             ratio = np.linalg.norm(p[k] - pos[J(f"Shoulder{s}")]) / (bm.UPPER_ARM * (height or 1.7))
-            ok[k] &= bool(ELBOW_REACH[0] <= ratio <= ELBOW_REACH[1])
+            ok[k] &= bool(conf[k] >= USE_CONFIDENCE or ELBOW_REACH[0] <= ratio <= ELBOW_REACH[1])
     if ONLY_INFERRED and chain:
         arms = [J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand") for s in SIDES]
         ok[arms] &= st[arms] != TRACKED

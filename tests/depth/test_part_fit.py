@@ -186,11 +186,11 @@ def test_a_doubted_arm_takes_a_less_confident_proposal(no_offsets):
 
 
 def test_an_elbow_proposal_by_the_shoulder_is_refused(no_offsets):
-    """An elbow part seen next to the shoulder (a hand on the face folds the arm there) is not the elbow: it
-    must lie about an upper arm's length from the shoulder."""
+    """A less confident elbow part seen next to the shoulder (a hand on the face folds the arm there) is not the
+    elbow: it must lie about an upper arm's length from the shoulder."""
     pos, st = _standing_pose()
     st[j("ElbowRight")] = INFERRED
-    props = _proposals(pos)
+    props = _proposals(pos, conf=0.5 * (part_fit.USE_CONFIDENCE + part_fit.DOUBTED_ARM_CONFIDENCE))
     props.positions[j("ElbowRight")] = pos[j("ShoulderRight")] + [0.0, -0.15, -0.05]   # 0.68 upper arms away
     before = pos.copy()
     part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
