@@ -69,8 +69,9 @@ class ConfidenceCheck:
         a, b = self._history[-2], self._history[-1]
         return b + VELOCITY_DAMPING * (b - a)
 
-    def assess(self, positions: np.ndarray, states: np.ndarray, fit) -> np.ndarray:
-        """States after the checks (never promotes a joint). `fit` is the frame's FitResult."""
+    def assess(self, positions: np.ndarray, states: np.ndarray, fit, own=None) -> np.ndarray:
+        """States after the checks (never promotes a joint). `fit` is the frame's FitResult; `own` ((20,) bool):
+        joints placed on their own evidence (a foot on its body-part proposal), not hanging on the limb above."""
         st = states.copy()
         doubt = np.zeros(20, bool)
         pred = self.predict()
@@ -88,7 +89,7 @@ class ConfidenceCheck:
             doubt[LIMB + SIDE_TORSO] = True
         for chain in CHAINS:   # beyond a doubtful joint the chain hangs on a guess
             bad = np.cumsum(doubt[chain]) > 0   # (an elbow the fit merely inferred leaves the hand its own evidence)
-            doubt[chain] |= bad & (st[chain] == TRACKED)
+            doubt[chain] |= bad & (st[chain] == TRACKED) & (True if own is None else ~own[chain])
         self._frames += 1
         turned = getattr(fit, "turned", False) or getattr(fit, "edge_on", False)
         self._facing_frames = 0 if turned else self._facing_frames + 1

@@ -183,7 +183,8 @@ def _foot(pos, st, p, conf, in_view, s, height, frame) -> bool:
 
 
 def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_floor: bool = False,
-                    in_view=True, frame: np.ndarray | None = None, turned: bool = False) -> np.ndarray:
+                    in_view=True, frame: np.ndarray | None = None,
+                    turned: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Move joints to confident proposals, in place (positions (20, 3), states (20,)). `frame`: the body's
     frame (body_frame) for the learned offsets (None: proposals stand for their joints as found).
     `no_floor`: no floor was found, so nothing removed what lies below the feet (a pre-segmented frame keeps
@@ -191,9 +192,10 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
     the fit says. `in_view` ((20,) bool): joints the fit placed inside the image (one continued past its edge
     keeps its place: the part seen at the edge is not its end). `turned`: the performer is turned well away
     from the sensor, where the forest confuses the arms' sides (the synthetic hop's 55 degree turn swapped the
-    hands): arms then move as a chain, only where the fit doubts them. Returns (20,) bool: joints not to be
-    reported tracked though the fit's history keeps its states (wrist and hand beyond an elbow the proposal
-    moved: the fit's arm was elsewhere)."""
+    hands): arms then move as a chain, only where the fit doubts them. Returns two (20,) bool masks: joints not
+    to be reported tracked though the fit's history keeps its states (wrist and hand beyond an elbow the
+    proposal moved: the fit's arm was elsewhere), and joints resting on their own part's evidence, not on the
+    limb above them (feet placed on confident proposals without a floor)."""
     conf, p = props.confidence, joint_positions(props, frame)
     chain = ARMS == "chain" or turned
     use = _usable(conf, p, pos, st, no_floor, in_view, chain, height)
@@ -214,6 +216,8 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
         st[(before_st == TRACKED) & (moved > AGREE)] = INFERRED
     if FEET_TRACKED:   # both feet's parts seen apart and within the legs' reach: as sure as the SDK's feet
         st[[f for f in feet if conf[f] >= TRACK_CONFIDENCE]] = TRACKED
+    own = np.zeros(20, bool)
+    own[[f for f in feet if FEET_TRACKED and conf[f] >= TRACK_CONFIDENCE]] = True
     if not chain:   # a wrist placed from its hand and elbow is no surer than they are
         for s in SIDES:
             el, wr, ha = (J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand"))
@@ -223,7 +227,7 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
     for s in SIDES:
         if moved[J(f"Elbow{s}")] > AGREE:
             doubt[[J(f"Wrist{s}"), J(f"Hand{s}")]] = True
-    return doubt
+    return doubt, own
 
 
 def disagreeing(pos: np.ndarray, props, frame: np.ndarray | None) -> np.ndarray:

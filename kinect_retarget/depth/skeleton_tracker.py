@@ -116,10 +116,12 @@ class SkeletonTracker:
             self.last_proposals = propose(self.forest, grid, person.mask)
             rc = grid.to_pixel(fit.positions)   # a limb the fit continued past the image's edge keeps its end
             in_view = np.all((rc >= 0) & (rc < np.array(grid.z.shape) - 1), axis=1)
-            doubt = apply_proposals(fit.positions, fit.states, self.last_proposals, self.calibration.height,
-                            no_floor=self.floor is None, in_view=in_view,
-                            frame=body_frame(fit.lateral, fit.axis), turned=fit.turned or fit.edge_on)
-        pos, st = fit.positions, self.confidence.assess(fit.positions, fit.states, fit)
+            doubt, own = apply_proposals(fit.positions, fit.states, self.last_proposals, self.calibration.height,
+                                         no_floor=self.floor is None, in_view=in_view,
+                                         frame=body_frame(fit.lateral, fit.axis), turned=fit.turned or fit.edge_on)
+        else:
+            doubt = own = np.zeros(20, bool)
+        pos, st = fit.positions, self.confidence.assess(fit.positions, fit.states, fit, own)
         if self.forest is not None:   # reported states only (the fit's history keeps its own)
             doubt |= disagreeing(pos, self.last_proposals, body_frame(fit.lateral, fit.axis))
             st[doubt & (st == TRACKED)] = INFERRED

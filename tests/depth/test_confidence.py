@@ -70,6 +70,16 @@ def test_checks_never_promote_a_joint(rng):
     assert st[J("WristRight")] == TRACKED       # a chain is demoted beyond a doubtful joint, not before it
 
 
+def test_a_joint_on_its_own_evidence_does_not_hang_on_the_limb_above(rng):
+    chk, pose, tracked = _steady(rng)
+    jumped = pose.copy()
+    jumped[J("KneeLeft")] += [0.4, 0.0, 0.0]        # a knee 40 cm off: the leg below it is doubted ...
+    own = np.zeros(20, bool)
+    own[J("FootLeft")] = True                        # ... but the foot stands on its own body-part proposal
+    st = chk.assess(jumped, tracked, _fit(), own)
+    assert st[J("KneeLeft")] == INFERRED and st[J("AnkleLeft")] == INFERRED and st[J("FootLeft")] == TRACKED
+
+
 def test_little_evidence_flags_the_limbs_and_sides(rng):
     chk, pose, tracked = _steady(rng)
     st = chk.assess(pose, tracked, _fit([("HandLeft", None), ("FootRight", None)]))  # side-on: 2 of 5 seen

@@ -121,9 +121,9 @@ def test_feet_without_a_floor_follow_their_proposals_and_refuse_one_foot_seen_tw
     assert np.array_equal(p[j("FootLeft")], fit[j("FootLeft")]) and s[j("FootLeft")] == INFERRED
     st_f = st.copy()
     st_f[j("FootLeft")] = INFERRED
-    p = fit.copy()   # a confident foot proposal, apart from the other and in the leg's reach: tracked
-    part_fit.apply_proposals(p, st_f, _proposals(pos), 1.7, no_floor=True, frame=FACING)
-    assert st_f[j("FootLeft")] == TRACKED
+    p = fit.copy()   # a confident foot proposal, apart from the other and in the leg's reach: tracked, on its
+    _, own = part_fit.apply_proposals(p, st_f, _proposals(pos), 1.7, no_floor=True, frame=FACING)   # own evidence
+    assert st_f[j("FootLeft")] == TRACKED and set(np.flatnonzero(own)) == {j("FootLeft"), j("FootRight")}
     p = fit.copy()   # with a floor in view the fit's feet stand
     part_fit.apply_proposals(p, st.copy(), _proposals(pos), 1.7, no_floor=False, frame=FACING)
     assert np.array_equal(p[j("FootLeft")], fit[j("FootLeft")])
@@ -169,8 +169,9 @@ def test_joints_far_from_confident_proposals_are_not_reported_tracked(no_offsets
     # an elbow the proposal moved far: the fit's wrist and hand beyond it are not claimed tracked
     props = _proposals(pos)
     props.positions[j("ElbowLeft")] += [-0.2, 0.05, 0.0]
-    doubt = part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    doubt, own = part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
     assert set(np.flatnonzero(doubt)) == {j("HandLeft"), j("WristLeft")} and st[j("ElbowLeft")] == INFERRED
+    assert not own.any()
 
 
 def test_a_doubted_arm_takes_a_less_confident_proposal(no_offsets):
