@@ -8,7 +8,7 @@ frames and its walk with turns all of 131_01), at several distances, sensor tilt
 the shipped tracker and collects, for every confident proposal (part_fit.USE_CONFIDENCE) within 15 cm of its
 ground-truth joint, the ground truth minus the proposal in the body frame the tracker fitted (outward, up,
 forward). The per-joint median, left and right pooled, is written to kinect_retarget/assets/
-part_joint_offsets.npz with this recipe. Seeded, about 5 minutes on one core.
+part_joint_offsets.npz with this recipe. Seeded, about 2 minutes on one core.
 """
 from __future__ import annotations
 
