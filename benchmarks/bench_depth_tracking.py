@@ -1,6 +1,6 @@
 """Depth -> skeleton tracking: accuracy on rendered real motions, speed, latency and robustness.
 
-    .venv/bin/python benchmarks/bench_depth_tracking.py [--only walk,hop,speed,...] [--save DIR]
+    .venv/bin/python benchmarks/bench_depth_tracking.py [--only walk,hop,speed,...] [--save DIR] [--forest PATH|none]
 
 Renders CMU mocap (walks 131_02 and 131_01, hop 131_03, forward jumps 01_01) on the MakeHuman body as Kinect v1 depth
 (cached in $KR_DEPTH_CACHE, default /tmp/kinect_retarget_depth_cache), tracks it, prints the figures.
@@ -25,7 +25,7 @@ sys.path.insert(0, str(REPO))
 from kinect_retarget.core.skeletons import KINECT_V1, NOT_TRACKED  # noqa: E402
 from kinect_retarget.sim.depth_scoring import facing_angle, score  # noqa: E402
 from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence  # noqa: E402
-from kinect_retarget.depth.skeleton_tracker import SkeletonTracker  # noqa: E402
+from kinect_retarget.depth.skeleton_tracker import SkeletonTracker, TrackerSettings  # noqa: E402
 
 from _common import shared_data_or_skip  # noqa: E402
 
@@ -49,6 +49,7 @@ FRONTAL_DEG = 45.0   # the SDK's design range: the performer faces the sensor
 # Development subset: the first half of every motion's frames; tuning looks only at these figures. The second
 # half is held out (tracked in the same run, since the tracker needs the history, but scored separately).
 DEV_FRACTION = 0.5
+SETTINGS = TrackerSettings()   # --forest replaces its body-part forest
 
 
 def cached(name: str, clip: str, frames: int, scenario: Scenario | None = None, start: int = 0):
@@ -66,7 +67,7 @@ def cached(name: str, clip: str, frames: int, scenario: Scenario | None = None, 
 
 
 def run(data):
-    tracker = SkeletonTracker(gravity=data["gravity"])
+    tracker = SkeletonTracker(gravity=data["gravity"], settings=SETTINGS)
     mm, times = np.asarray(data["mm"]), np.asarray(data["times"])  # an NpzFile decompresses on every access
     data = {"mm": mm, "times": times}
     n = len(mm)
@@ -96,7 +97,11 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--only", help="comma-separated motion/scenario names to run")
     ap.add_argument("--save", help="directory to write each motion's tracked positions/states (.npz)")
+    ap.add_argument("--forest", help="body-part forest (.npz) to track with instead of the shipped one; 'none': "
+                    "track without body parts")
     args = ap.parse_args()
+    if args.forest:
+        SETTINGS.part_forest = None if args.forest == "none" else args.forest
     only = set(args.only.split(",")) if args.only else None
     print("depth tracking benchmark (640x480 input, one thread; errors in cm)")
     all_lat, errs, frontal_errs, named = [], [], [], {}

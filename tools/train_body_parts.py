@@ -255,8 +255,9 @@ def make_data(args):
     results, t0 = [], time.perf_counter()
     for k, res in enumerate(pool.imap(_chunk_samples, tasks) if pool else map(_chunk_samples, tasks)):
         results.append(res)
-        print(f"  {min((k + 1) * CHUNK, args.images)}/{args.images} images, {time.perf_counter() - t0:.0f} s",
-              flush=True)
+        if (k + 1) % 20 == 0 or k + 1 == len(tasks):
+            print(f"  {min((k + 1) * CHUNK, args.images)}/{args.images} images, {time.perf_counter() - t0:.0f} s",
+                  flush=True)
     if pool:
         pool.close()
     return np.concatenate([r[0] for r in results]), np.concatenate([r[1] for r in results]), offsets
