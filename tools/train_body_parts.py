@@ -224,7 +224,7 @@ def _chunk_samples(task):
     if path is not None and path.exists():
         with np.load(path) as d:
             return d["x"], d["y"]
-    cells_per_m, xs, ys = _W["cam"].f / STEP, [], []
+    cells_per_m, xs, ys, images = _W["cam"].f / STEP, [], [], []
     for i, (zb, glab) in enumerate(person_grids(first, count)):
         r, c = np.nonzero(glab != BACKGROUND)
         if len(r) < 50:
@@ -234,9 +234,10 @@ def _chunk_samples(task):
         xs.append(probe_features(zb.astype(np.float64), r[pick], c[pick], offsets[None], cells_per_m)
                   .astype(np.float32))
         ys.append(glab[r[pick], c[pick]])
+        images.append(first + i)
     x, y = np.concatenate(xs), np.concatenate(ys)
-    if path is not None:
-        np.savez(path, x=x, y=y)
+    if path is not None:   # each sample's image too, so a later run can leave some images out
+        np.savez(path, x=x, y=y, image=np.repeat(np.asarray(images), [len(v) for v in ys]))
     return x, y
 
 
