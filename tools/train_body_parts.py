@@ -1,7 +1,7 @@
 """Train the body-part forest the depth tracker ships (kinect_retarget/assets/body_parts_forest.npz).
 
     .venv/bin/python tools/train_body_parts.py [--images 6000] [--pixels 400] [--trees 3] [--depth 20]
-                                               [--seed 0] [--jobs 2] [--out PATH] [--cache DIR]
+                                               [--seed 0] [--jobs 2] [--balance 1.0] [--out PATH] [--cache DIR]
     .venv/bin/python tools/train_body_parts.py --evaluate FOREST.npz [FOREST.npz ...] [--images 300] [--seed 99]
                                                [--plain]
 
@@ -19,7 +19,10 @@ edge dropouts, disparity noise and quantisation (sim/depth_render.kinect_artifac
 body_parts.PARTS from the mesh's skin weights (sim/body_part_labels.py). Each image's person cells on the
 tracker's 4-pixel grid are sampled, and a pool of depth-difference features is evaluated on them;
 scikit-learn's RandomForestClassifier picks from the pool at every split; the trees are flattened into numpy
-arrays (part_forest.PartForest).
+arrays (part_forest.PartForest). Small parts (hands, wrists, ankles: 0.4 % of the samples against 10 % for the
+chest) would hardly shape the splits, so each sample is weighted by its part's frequency to the power
+-`--balance` while the trees grow (1.0: every part weighs the same); the leaves' part probabilities are then
+counted again without weights, so they stay the plain frequencies the proposals' thresholds expect.
 
 Seeded: image i and performer g draw from their own generators (seed, i) and (seed, g), so the same
 arguments give the same data (and trees) whatever --jobs is; --cache DIR keeps 50-image chunks and resumes.
@@ -292,6 +295,15 @@ def evaluate(args) -> None:
         print("  per part: " + ", ".join(f"{PARTS[k]} {hit[k] / seen[k]:.2f}" for k in range(len(PARTS)) if seen[k]))
 
 
+def recount_leaves(forest, x, y) -> None:
+    """Each tree's node values become the unweighted part counts of the training samples reaching it."""
+    cls = np.searchsorted(forest.classes_, y)
+    for est in forest.estimators_:
+        counts = np.zeros((est.tree_.node_count, len(forest.classes_)))
+        np.add.at(counts, (est.apply(x), cls), 1.0)
+        est.tree_.value[:, 0, :] = counts
+
+
 def flatten(forest, offsets) -> PartForest:
     """scikit-learn trees -> one set of flat node arrays (leaves loop onto themselves)."""
     feats, thr, left, right, probs, roots, depth, n0 = [], [], [], [], [], [], 0, 0
@@ -324,6 +336,8 @@ def main() -> None:
     ap.add_argument("--depth", type=int, default=20)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--jobs", type=int, default=2, help="rendering processes (the data do not depend on it)")
+    ap.add_argument("--balance", type=float, default=1.0,
+                    help="weight samples by part frequency ** -BALANCE while growing the trees (0: unweighted)")
     ap.add_argument("--out", default=MODEL_PATH)
     ap.add_argument("--cache", help="directory keeping the sampled features of each 50-image chunk (resumes)")
     ap.add_argument("--data-only", action="store_true", help="render and sample (into --cache), do not train")
@@ -341,12 +355,16 @@ def main() -> None:
         return
     from sklearn.ensemble import RandomForestClassifier
     print(f"training {args.trees} trees of depth {args.depth} on {x.shape[1]} candidate features", flush=True)
+    freq = np.bincount(y, minlength=len(PARTS)) / len(y)
+    weight = np.maximum(freq, 1e-9)[y] ** -args.balance
     rf = RandomForestClassifier(n_estimators=args.trees, max_depth=args.depth, max_features=40,
-                                min_samples_leaf=5, random_state=args.seed, n_jobs=1).fit(x, y)
+                                min_samples_leaf=5, random_state=args.seed, n_jobs=1)
+    rf.fit(x, y, sample_weight=weight * (len(y) / weight.sum()))
+    recount_leaves(rf, x, y)
     forest = flatten(rf, offsets)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     forest.save(args.out, images=args.images, pixels=args.pixels, trees=args.trees, depth=args.depth,
-                seed=args.seed, samples=int(len(y)), data_s=round(t1 - t0), train_s=round(time.perf_counter() - t1))
+                seed=args.seed, balance=args.balance, samples=int(len(y)), data_s=round(t1 - t0), train_s=round(time.perf_counter() - t1))
     print(f"wrote {args.out}: {len(forest.feature)} nodes, depth {forest.depth} "
           f"({Path(args.out).stat().st_size / 1e6:.1f} MB); training took {time.perf_counter() - t1:.0f} s")
 

@@ -7,8 +7,10 @@ body's frame (outward, up, forward), learned on rendered MakeHuman bodies by too
 Joints in DIRECT (head, shoulders; elbows and hands with ARMS = "direct") take a confident proposal near the
 fit that is not nearer the other side's joint; the wrist then sits a hand's length before the hand, on the
 line from the elbow. ARMS = "chain" instead moves only the arm joints the fit doubts, as a chain with the
-calibrated bone lengths. Hips and knees never take proposals (theirs sat 20-25 cm low on real legs); feet do
-when no floor was found. Settings chosen on the real-depth benchmark's subjects 1-2 within the synthetic
+calibrated bone lengths. Knees take confident proposals as found (the class-balanced forest's knee parts lie
+about 8 cm from the SDK's knees on real legs; the first forest's sat 28 cm low), except for a performer turned
+well away, where the forest confuses the legs' sides; hips never do (their parts' centres are not the SDK's
+hip joints); feet do when no floor was found. Settings chosen on the real-depth benchmark's subjects 1-2 within the synthetic
 benchmark's bound (docs/depth_tracking.md).
 """
 from __future__ import annotations
@@ -51,10 +53,11 @@ WRIST_BEFORE_HAND = SDK_HAND   # the wrist of a proposed hand sits this far befo
 ANKLE_FROM_FOOT = False
 FEET_TRACKED = True         # without a floor, a foot on a confident proposal (TRACK_CONFIDENCE) is reported tracked
 ELBOW_REACH = (0.85, 1.45)  # less confident elbow proposal to shoulder, in upper arms (the SDK's upper arm is 1.1-1.2 of ours)
+KNEES = True                # knees from confident proposals (a forest whose knee parts are right on real legs)
 FEET_APART = 0.08           # m: foot proposals nearer each other than this are one foot seen twice
-NO_OFFSET = ("AnkleLeft", "AnkleRight", "FootLeft", "FootRight")   # proposals used as found (see below)
+NO_OFFSET = ("AnkleLeft", "AnkleRight", "FootLeft", "FootRight", "KneeLeft", "KneeRight")   # proposals used as found (see below)
 DISAGREE = 0.15             # m from a confident proposal beyond which a joint is reported inferred
-# joints whose proposals check the fit's states (hips and knees: their parts sat 20-25 cm low on real legs)
+# joints whose proposals check the fit's states (not hips, knees or spine: the fit's states stand for those)
 CHECKED = np.array([not n.startswith(("Hip", "Knee", "Spine")) for n in KINECT_V1.joints])
 OUTWARD = np.array([1.0 if "Left" in n else -1.0 if "Right" in n else 0.0 for n in KINECT_V1.joints])
 
@@ -85,7 +88,8 @@ def joint_positions(props, frame: np.ndarray | None, offsets: np.ndarray | None 
         return props.positions.copy()
     off = (load_offsets() if offsets is None else offsets).copy()
     # MakeHuman's foot joint is the toe's base, the SDK's sits further back: as found, foot proposals were
-    # 3.9-5.3 cm from the SDK's feet on real depth, with the learned offset (4 cm forward) worse
+    # 3.9-5.3 cm from the SDK's feet on real depth, with the learned offset (4 cm forward) worse; knees as
+    # found sat nearer the SDK's than with MakeHuman's offset (3.4 cm down): 7.6-9.5 against 9.2-10.0 cm
     off[[J(n) for n in NO_OFFSET]] = 0.0
     local = off * np.stack([np.where(OUTWARD == 0, 1.0, OUTWARD), np.ones(20), np.ones(20)], axis=1)
     return props.positions + local @ frame
@@ -124,7 +128,7 @@ def _usable(conf, p, pos, st, no_floor: bool, in_view, chain: bool, height=None)
         arms = [J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand") for s in SIDES]
         ok[arms] &= st[arms] != TRACKED
     for s, o in (("Left", "Right"), ("Right", "Left")):
-        for n in ("Shoulder", "Elbow", "Wrist", "Hand", "Ankle", "Foot"):
+        for n in ("Shoulder", "Elbow", "Wrist", "Hand", "Knee", "Ankle", "Foot"):
             j, k = J(f"{n}{s}"), J(f"{n}{o}")
             ok[j] &= bool(np.linalg.norm(p[j] - pos[k]) > move[j]) or (ARM_REACH and st[j] != TRACKED and st[k] != TRACKED)
     return ok
@@ -209,6 +213,9 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
         (_arm_chain if chain else _arm_direct)(pos, st, p, conf, use, s, height)
         if (FEET or no_floor) and _foot(pos, st, p, conf, in_view, s, height, frame):
             feet.append(J(f"Foot{s}"))
+        k = J(f"Knee{s}")
+        if KNEES and use[k] and not turned:   # turned, the forest confuses the legs' sides as it does the arms'
+            pos[k], st[k] = p[k], _state(conf[k])
     # the fit's tracked joints stay tracked where the proposal agrees with them
     moved = np.linalg.norm(pos - before, axis=1)
     st[(before_st == TRACKED) & (moved <= AGREE)] = TRACKED

@@ -108,6 +108,7 @@ def test_feet_without_a_floor_follow_their_proposals_and_refuse_one_foot_seen_tw
     fit = pos.copy()
     fit[j("FootLeft")] = fit[j("FootRight")] + [0.02, 0, 0]   # the fit put both feet on the right one
     props = _proposals(pos)
+    props.confidence[[j("KneeLeft"), j("KneeRight")]] = 0.0   # no knee parts seen (those would place the knee)
     p, s = fit.copy(), st.copy()
     part_fit.apply_proposals(p, s, props, 1.7, no_floor=True, frame=FACING)
     assert np.allclose(p[j("FootLeft")], pos[j("FootLeft")])
@@ -196,3 +197,21 @@ def test_an_elbow_proposal_by_the_shoulder_is_refused(no_offsets):
     before = pos.copy()
     part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
     assert np.array_equal(pos[j("ElbowRight")], before[j("ElbowRight")])
+
+
+def test_knees_take_confident_proposals_as_found_unless_turned(no_offsets):
+    pos, st = _standing_pose()
+    props = _proposals(pos)
+    props.positions[j("KneeLeft")] = [-0.12, -0.48, 2.38]    # the left knee lifted forward
+    props.positions[j("KneeRight")] = [-0.06, -0.5, 2.45]    # nearer the left knee: sides confused, refused
+    offsets = np.zeros((20, 3))
+    offsets[[j("KneeLeft"), j("KneeRight")]] = [0.0, -0.05, 0.0]   # knees are used as found, without offsets
+    props_pos = props.positions.copy()
+    before = pos.copy()
+    part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    assert np.allclose(pos[j("KneeLeft")], props_pos[j("KneeLeft")])
+    assert np.allclose(pos[j("KneeRight")], before[j("KneeRight")])
+    assert np.allclose(part_fit.joint_positions(props, FACING, offsets)[j("KneeLeft")], props_pos[j("KneeLeft")])
+    pos, st = _standing_pose()
+    part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING, turned=True)   # turned: the fit's knees stay
+    assert np.allclose(pos[j("KneeLeft")], before[j("KneeLeft")])
