@@ -53,6 +53,7 @@ WRIST_BEFORE_HAND = SDK_HAND   # the wrist of a proposed hand sits this far befo
 ANKLE_FROM_FOOT = False
 FEET_TRACKED = True         # without a floor, a foot on a confident proposal (TRACK_CONFIDENCE) is reported tracked
 ELBOW_REACH = (0.85, 1.45)  # less confident elbow proposal to shoulder, in upper arms (the SDK's upper arm is 1.1-1.2 of ours)
+ELBOW_HAND_MIN = 0.6        # an elbow proposal nearer its hand's than this many forearms is refused
 KNEES = True                # knees from confident proposals (a forest whose knee parts are right on real legs)
 FEET_APART = 0.08           # m: foot proposals nearer each other than this are one foot seen twice
 NO_OFFSET = ("AnkleLeft", "AnkleRight", "FootLeft", "FootRight", "KneeLeft", "KneeRight")   # proposals used as found (see below)
@@ -124,6 +125,10 @@ def _usable(conf, p, pos, st, no_floor: bool, in_view, chain: bool, height=None)
             k = J(f"Elbow{s}")
             ratio = np.linalg.norm(p[k] - pos[J(f"Shoulder{s}")]) / (bm.UPPER_ARM * (height or 1.7))
             ok[k] &= bool(conf[k] >= USE_CONFIDENCE or ELBOW_REACH[0] <= ratio <= ELBOW_REACH[1])
+    if not chain:   # an elbow proposal by its own hand's is a hand part taken for the elbow (the forearm is
+        for s in SIDES:   # rigid): with a hand on the face the class-balanced forest saw one there, 24 cm off
+            el, ha = J(f"Elbow{s}"), J(f"Hand{s}")
+            ok[el] &= not (ok[ha] and np.linalg.norm(p[el] - p[ha]) < ELBOW_HAND_MIN * bm.FOREARM * (height or 1.7))
     if ONLY_INFERRED and chain:
         arms = [J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand") for s in SIDES]
         ok[arms] &= st[arms] != TRACKED

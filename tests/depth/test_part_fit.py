@@ -215,3 +215,18 @@ def test_knees_take_confident_proposals_as_found_unless_turned(no_offsets):
     pos, st = _standing_pose()
     part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING, turned=True)   # turned: the fit's knees stay
     assert np.allclose(pos[j("KneeLeft")], before[j("KneeLeft")])
+
+
+def test_an_elbow_proposal_at_its_own_hand_is_refused(no_offsets):
+    pos, st = _standing_pose()
+    props = _proposals(pos)
+    st[[j("ElbowRight"), j("WristRight"), j("HandRight")]] = INFERRED   # the fit lost the raised arm
+    props.positions[j("HandRight")] = [0.1, 0.55, 2.4]       # the right hand raised to the face
+    props.positions[j("ElbowRight")] = [0.12, 0.5, 2.4]      # a hand part taken for the elbow, beside it
+    before = pos.copy()
+    part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    assert np.allclose(pos[j("HandRight")], [0.1, 0.55, 2.4])
+    assert np.allclose(pos[j("ElbowRight")], before[j("ElbowRight")])
+    props.positions[j("ElbowRight")] = [0.3, 0.25, 2.4]      # an elbow a forearm away from that hand is taken
+    part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    assert np.allclose(pos[j("ElbowRight")], [0.3, 0.25, 2.4])
