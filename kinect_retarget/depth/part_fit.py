@@ -53,8 +53,11 @@ WRIST_BEFORE_HAND = SDK_HAND   # the wrist of a proposed hand sits this far befo
 ANKLE_FROM_FOOT = False
 FEET_TRACKED = True         # without a floor, a foot on a confident proposal (TRACK_CONFIDENCE) is reported tracked
 ELBOW_REACH = (0.85, 1.45)  # less confident elbow proposal to shoulder, in upper arms (the SDK's upper arm is 1.1-1.2 of ours)
+FOREARM_MIN = 1.0           # a hand proposal nearer its elbow than this share of elbow-to-hand is moved out to it
 ELBOW_HAND_MIN = 0.6        # an elbow proposal nearer its hand's than this many forearms is refused
+ANKLES_TRACKED = False      # an ankle moved with a foot on its own confident part is reported tracked
 KNEES = True                # knees from confident proposals (a forest whose knee parts are right on real legs)
+KNEES_TRACKED = True        # ... reported tracked from TRACK_CONFIDENCE
 FEET_APART = 0.08           # m: foot proposals nearer each other than this are one foot seen twice
 NO_OFFSET = ("AnkleLeft", "AnkleRight", "FootLeft", "FootRight", "KneeLeft", "KneeRight")   # proposals used as found (see below)
 DISAGREE = 0.15             # m from a confident proposal beyond which a joint is reported inferred
@@ -159,6 +162,9 @@ def _arm_direct(pos, st, p, conf, use, s, height) -> None:
         pos[el], st[el] = p[el], _state(conf[el])
     if use[ha]:
         pos[ha], st[ha] = p[ha], _state(conf[ha])
+        reach = (bm.FOREARM + WRIST_BEFORE_HAND) * height   # elbow to hand joint, the forearm being rigid
+        if np.linalg.norm(pos[ha] - pos[el]) < FOREARM_MIN * reach:   # a hand part seen only up the forearm
+            pos[ha] = pos[el] + _unit(pos[ha] - pos[el]) * reach
         pos[wr] = pos[ha] - _unit(pos[ha] - pos[el]) * WRIST_BEFORE_HAND * height
         st[wr] = _state(min(conf[el], conf[ha]))
 
@@ -214,6 +220,7 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
         if use[j]:
             pos[j], st[j] = p[j], _state(conf[j])
     feet: list[int] = []
+    knees: list[int] = []
     for s in SIDES:
         (_arm_chain if chain else _arm_direct)(pos, st, p, conf, use, s, height)
         if (FEET or no_floor) and _foot(pos, st, p, conf, in_view, s, height, frame):
@@ -221,6 +228,8 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
         k = J(f"Knee{s}")
         if KNEES and use[k] and not turned:   # turned, the forest confuses the legs' sides as it does the arms'
             pos[k], st[k] = p[k], _state(conf[k])
+            if KNEES_TRACKED and conf[k] >= TRACK_CONFIDENCE:
+                knees.append(k)
     # the fit's tracked joints stay tracked where the proposal agrees with them
     moved = np.linalg.norm(pos - before, axis=1)
     st[(before_st == TRACKED) & (moved <= AGREE)] = TRACKED
@@ -230,6 +239,12 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
         st[[f for f in feet if conf[f] >= TRACK_CONFIDENCE]] = TRACKED
     own = np.zeros(20, bool)
     own[[f for f in feet if FEET_TRACKED and conf[f] >= TRACK_CONFIDENCE]] = True
+    st[knees] = TRACKED   # a knee on its own confident part is seen, whatever the leg's chain says
+    own[knees] = True
+    if ANKLES_TRACKED:    # an ankle carried with its foot onto the foot's own part
+        for s in SIDES:
+            if own[J(f"Foot{s}")]:
+                st[J(f"Ankle{s}")], own[J(f"Ankle{s}")] = TRACKED, True
     if not chain:   # a wrist placed from its hand and elbow is no surer than they are
         for s in SIDES:
             el, wr, ha = (J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand"))

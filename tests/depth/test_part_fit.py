@@ -124,7 +124,8 @@ def test_feet_without_a_floor_follow_their_proposals_and_refuse_one_foot_seen_tw
     st_f[j("FootLeft")] = INFERRED
     p = fit.copy()   # a confident foot proposal, apart from the other and in the leg's reach: tracked, on its
     _, own = part_fit.apply_proposals(p, st_f, _proposals(pos), 1.7, no_floor=True, frame=FACING)   # own evidence
-    assert st_f[j("FootLeft")] == TRACKED and set(np.flatnonzero(own)) == {j("FootLeft"), j("FootRight")}
+    assert st_f[j("FootLeft")] == TRACKED   # (the knees rest on their own confident parts too)
+    assert set(np.flatnonzero(own)) == {j("FootLeft"), j("FootRight"), j("KneeLeft"), j("KneeRight")}
     p = fit.copy()   # with a floor in view the fit's feet stand
     part_fit.apply_proposals(p, st.copy(), _proposals(pos), 1.7, no_floor=False, frame=FACING)
     assert np.array_equal(p[j("FootLeft")], fit[j("FootLeft")])
@@ -172,7 +173,7 @@ def test_joints_far_from_confident_proposals_are_not_reported_tracked(no_offsets
     props.positions[j("ElbowLeft")] += [-0.2, 0.05, 0.0]
     doubt, own = part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
     assert set(np.flatnonzero(doubt)) == {j("HandLeft"), j("WristLeft")} and st[j("ElbowLeft")] == INFERRED
-    assert not own.any()
+    assert set(np.flatnonzero(own)) == {j("KneeLeft"), j("KneeRight")}   # only the knees on their own parts
 
 
 def test_a_doubted_arm_takes_a_less_confident_proposal(no_offsets):
@@ -210,6 +211,7 @@ def test_knees_take_confident_proposals_as_found_unless_turned(no_offsets):
     before = pos.copy()
     part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
     assert np.allclose(pos[j("KneeLeft")], props_pos[j("KneeLeft")])
+    assert st[j("KneeLeft")] == TRACKED   # on its own confident part: seen
     assert np.allclose(pos[j("KneeRight")], before[j("KneeRight")])
     assert np.allclose(part_fit.joint_positions(props, FACING, offsets)[j("KneeLeft")], props_pos[j("KneeLeft")])
     pos, st = _standing_pose()
@@ -230,3 +232,13 @@ def test_an_elbow_proposal_at_its_own_hand_is_refused(no_offsets):
     props.positions[j("ElbowRight")] = [0.3, 0.25, 2.4]      # an elbow a forearm away from that hand is taken
     part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
     assert np.allclose(pos[j("ElbowRight")], [0.3, 0.25, 2.4])
+
+
+def test_a_hand_part_seen_only_up_the_forearm_is_moved_out_to_the_forearm_length(no_offsets):
+    pos, st = _standing_pose()
+    props = _proposals(pos)
+    props.positions[j("HandLeft")] = [-0.17, 0.0, 2.5]    # 12 cm below the elbow: the forearm's middle
+    part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    reach = (part_fit.bm.FOREARM + part_fit.WRIST_BEFORE_HAND) * 1.7
+    assert np.allclose(pos[j("HandLeft")], [-0.17, 0.12 - reach, 2.5])
+    assert np.allclose(pos[j("HandRight")], [0.17, -0.2, 2.5])   # a full forearm away: as proposed
