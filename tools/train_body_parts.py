@@ -1,7 +1,8 @@
 """Train the body-part forest the depth tracker ships (kinect_retarget/assets/body_parts_forest.npz).
 
     .venv/bin/python tools/train_body_parts.py [--images 6000] [--pixels 400] [--trees 3] [--depth 20]
-                                               [--seed 0] [--jobs 2] [--balance 1.0] [--out PATH] [--cache DIR]
+                                               [--seed 0] [--jobs 2] [--balance 1.0] [--no-skirts] [--out PATH]
+                                               [--cache DIR]
     .venv/bin/python tools/train_body_parts.py --evaluate FOREST.npz [FOREST.npz ...] [--images 300] [--seed 99]
                                                [--plain]
 
@@ -50,7 +51,8 @@ from kinect_retarget.depth.depth_camera import DepthCamera, raw_to_mm  # noqa: E
 from kinect_retarget.depth.part_forest import BACKGROUND_DEPTH, MODEL_PATH, PartForest, load_forest, probe_features  # noqa: E402
 from kinect_retarget.depth.segmentation import DepthGrid  # noqa: E402
 from kinect_retarget.sim.body_part_labels import render_parts, surface_labels, vertex_parts  # noqa: E402
-from kinect_retarget.sim.body_population import clothed_body, proportioned_body, random_proportions, take_points  # noqa: E402
+from kinect_retarget.sim.body_population import (GARMENTS, SKIRT_CHANCE, clothed_body, proportioned_body,  # noqa: E402
+                                                  random_proportions, take_points)
 from kinect_retarget.sim.bvh_motion import read_bvh_positions  # noqa: E402
 from kinect_retarget.sim.depth_render import _tilt, kinect_artifacts, quad_sampler, surface_points  # noqa: E402
 from kinect_retarget.sim.makehuman_body import DRIVER_NAMES, load_body  # noqa: E402
@@ -226,7 +228,11 @@ def _chunk_samples(task):
     path = Path(cache) / f"chunk_{first:06d}_{count}_{pixels}.npz" if cache else None
     if path is not None and path.exists():
         with np.load(path) as d:
-            return d["x"], d["y"]
+            if "image" in d.files:
+                return d["x"], d["y"], d["image"]
+            if len(d["y"]) == count * pixels:   # (older chunks: every image gave `pixels` samples, in order)
+                return d["x"], d["y"], first + np.arange(len(d["y"])) // pixels
+        # an older chunk with a short image: which samples are whose is not recorded, so render it again
     cells_per_m, xs, ys, images = _W["cam"].f / STEP, [], [], []
     for i, (zb, glab) in enumerate(person_grids(first, count)):
         r, c = np.nonzero(glab != BACKGROUND)
@@ -239,9 +245,10 @@ def _chunk_samples(task):
         ys.append(glab[r[pick], c[pick]])
         images.append(first + i)
     x, y = np.concatenate(xs), np.concatenate(ys)
+    image = np.repeat(np.asarray(images), [len(v) for v in ys])
     if path is not None:   # each sample's image too, so a later run can leave some images out
-        np.savez(path, x=x, y=y, image=np.repeat(np.asarray(images), [len(v) for v in ys]))
-    return x, y
+        np.savez(path, x=x, y=y, image=image)
+    return x, y, image
 
 
 def _pool(jobs: int):
@@ -264,7 +271,38 @@ def make_data(args):
                   flush=True)
     if pool:
         pool.close()
-    return np.concatenate([r[0] for r in results]), np.concatenate([r[1] for r in results]), offsets
+    x, y, image = (np.concatenate([r[k] for r in results]) for k in range(3))
+    if args.no_skirts:   # leave out the images of performers who wear a skirt or coat hem
+        keep = ~skirted_performers(args.seed, args.images // PER_BODY + 1)[image // PER_BODY]
+        print(f"  leaving out the {np.sum(~keep)} samples of skirted performers' images", flush=True)
+        x, y = x[keep], y[keep]
+    return x, y, offsets
+
+
+def skirted_performers(seed: int, count: int) -> np.ndarray:
+    """(count,) bool: which of performers 0..count-1 wear a skirt or coat hem. performer()'s seeded draws are
+    replayed up to that choice without building the bodies, and checked against built bodies here."""
+    out = np.array([_skirt_drawn(np.random.default_rng([seed, 2, g])) for g in range(count)])
+    base = _W["base"]
+    for g in (int(np.argmax(out)), int(np.argmin(out))):   # one of each, built for real
+        body = performer(base, _W["vlab"], np.random.default_rng([seed, 2, g]), _W["cam"])[0]
+        assert (len(body.rest_vertices) > len(base.rest_vertices)) == out[g], "skirt replay out of step"
+    return out
+
+
+def _skirt_drawn(rng) -> bool:
+    """performer()'s draws in order: proportions, varied_body's girths, clothed_body's garments and hair."""
+    random_proportions(rng)
+    rng.uniform(size=2)
+    for name in DRIVER_NAMES:
+        if name not in ("pelvis", "abdomen", "chest", "head"):
+            rng.uniform()
+    for _ in GARMENTS:
+        if rng.random() < 0.7:
+            rng.uniform()
+    if rng.random() < 0.6:
+        rng.uniform()
+    return bool(rng.random() < SKIRT_CHANCE)
 
 
 def evaluate(args) -> None:
@@ -338,6 +376,8 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=2, help="rendering processes (the data do not depend on it)")
     ap.add_argument("--balance", type=float, default=1.0,
                     help="weight samples by part frequency ** -BALANCE while growing the trees (0: unweighted)")
+    ap.add_argument("--no-skirts", action="store_true",
+                    help="leave out the images of performers wearing a skirt or coat hem (same seeds otherwise)")
     ap.add_argument("--out", default=MODEL_PATH)
     ap.add_argument("--cache", help="directory keeping the sampled features of each 50-image chunk (resumes)")
     ap.add_argument("--data-only", action="store_true", help="render and sample (into --cache), do not train")
@@ -364,7 +404,7 @@ def main() -> None:
     forest = flatten(rf, offsets)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     forest.save(args.out, images=args.images, pixels=args.pixels, trees=args.trees, depth=args.depth,
-                seed=args.seed, balance=args.balance, samples=int(len(y)), data_s=round(t1 - t0), train_s=round(time.perf_counter() - t1))
+                seed=args.seed, balance=args.balance, no_skirts=args.no_skirts, samples=int(len(y)), data_s=round(t1 - t0), train_s=round(time.perf_counter() - t1))
     print(f"wrote {args.out}: {len(forest.feature)} nodes, depth {forest.depth} "
           f"({Path(args.out).stat().st_size / 1e6:.1f} MB); training took {time.perf_counter() - t1:.0f} s")
 

@@ -57,7 +57,7 @@ FOREARM_MIN = 1.0           # a hand proposal nearer its elbow than this share o
 ELBOW_HAND_MIN = 0.6        # an elbow proposal nearer its hand's than this many forearms is refused
 ANKLES_TRACKED = False      # an ankle moved with a foot on its own confident part is reported tracked
 KNEES = True                # knees from confident proposals (a forest whose knee parts are right on real legs)
-KNEES_TRACKED = True        # ... reported tracked from TRACK_CONFIDENCE
+KNEES_TRACKED = True        # ... reported tracked from TRACK_CONFIDENCE where within AGREE of the fit's knee
 FEET_APART = 0.08           # m: foot proposals nearer each other than this are one foot seen twice
 NO_OFFSET = ("AnkleLeft", "AnkleRight", "FootLeft", "FootRight", "KneeLeft", "KneeRight")   # proposals used as found (see below)
 DISAGREE = 0.15             # m from a confident proposal beyond which a joint is reported inferred
@@ -228,8 +228,8 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
         k = J(f"Knee{s}")
         if KNEES and use[k] and not turned:   # turned, the forest confuses the legs' sides as it does the arms'
             pos[k], st[k] = p[k], _state(conf[k])
-            if KNEES_TRACKED and conf[k] >= TRACK_CONFIDENCE:
-                knees.append(k)
+            if KNEES_TRACKED and conf[k] >= TRACK_CONFIDENCE and np.linalg.norm(p[k] - before[k]) <= AGREE:
+                knees.append(k)   # the forest's knee and the fit's agree
     # the fit's tracked joints stay tracked where the proposal agrees with them
     moved = np.linalg.norm(pos - before, axis=1)
     st[(before_st == TRACKED) & (moved <= AGREE)] = TRACKED
@@ -239,7 +239,7 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
         st[[f for f in feet if conf[f] >= TRACK_CONFIDENCE]] = TRACKED
     own = np.zeros(20, bool)
     own[[f for f in feet if FEET_TRACKED and conf[f] >= TRACK_CONFIDENCE]] = True
-    st[knees] = TRACKED   # a knee on its own confident part is seen, whatever the leg's chain says
+    st[knees] = TRACKED   # a knee on its own confident part, where the fit put it too, is seen
     own[knees] = True
     if ANKLES_TRACKED:    # an ankle carried with its foot onto the foot's own part
         for s in SIDES:

@@ -32,6 +32,7 @@ _LIMB_SEGMENT = {"upperarm": "upperarm", "lowerarm": "forearm", "hand": "hand", 
 GARMENTS = {"top": (("pelvis", "abdomen", "chest"), 0.045), "sleeves": (("upperarm", "lowerarm"), 0.025),
             "trousers": (("upperleg", "lowerleg"), 0.03)}
 HAIR_MAX = 0.05           # metres of hair volume on the crown
+SKIRT_CHANCE = 0.2        # share of performers with a skirt or coat hem
 SKIRT_FLARE = (0.03, 0.2)  # extra radius at the hem, metres
 
 
@@ -116,7 +117,7 @@ def _outward(body: BodyModel) -> np.ndarray:
 
 
 def clothed_body(body: BodyModel, labels: np.ndarray, rng: np.random.Generator,
-                 skirt_chance: float = 0.2) -> tuple[BodyModel, np.ndarray]:
+                 skirt_chance: float = SKIRT_CHANCE) -> tuple[BodyModel, np.ndarray]:
     """Loose clothes and hair as offset surfaces on `body` (rest pose); (body, per-vertex labels). Offsets
     move vertices along their outward normals (labels unchanged); a skirt/coat hem adds a skinned tube whose
     vertices take the label and skin weights of the nearest body vertex."""
