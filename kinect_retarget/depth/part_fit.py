@@ -163,7 +163,10 @@ def _arm_direct(pos, st, p, conf, use, s, height) -> None:
     if use[ha]:
         pos[ha], st[ha] = p[ha], _state(conf[ha])
         reach = (bm.FOREARM + WRIST_BEFORE_HAND) * height   # elbow to hand joint, the forearm being rigid
-        if np.linalg.norm(pos[ha] - pos[el]) < FOREARM_MIN * reach:   # a hand part seen only up the forearm
+        upper = np.linalg.norm(pos[el] - pos[J(f"Shoulder{s}")]) / (bm.UPPER_ARM * height)
+        # a hand part seen only up the forearm, from an elbow where an elbow can be (from one by the shoulder
+        # the forearm's direction is unknown: real frames nearer than any training image put hands off the body)
+        if np.linalg.norm(pos[ha] - pos[el]) < FOREARM_MIN * reach and ELBOW_REACH[0] <= upper <= ELBOW_REACH[1]:
             pos[ha] = pos[el] + _unit(pos[ha] - pos[el]) * reach
         pos[wr] = pos[ha] - _unit(pos[ha] - pos[el]) * WRIST_BEFORE_HAND * height
         st[wr] = _state(min(conf[el], conf[ha]))

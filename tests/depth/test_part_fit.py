@@ -242,3 +242,10 @@ def test_a_hand_part_seen_only_up_the_forearm_is_moved_out_to_the_forearm_length
     reach = (part_fit.bm.FOREARM + part_fit.WRIST_BEFORE_HAND) * 1.7
     assert np.allclose(pos[j("HandLeft")], [-0.17, 0.12 - reach, 2.5])
     assert np.allclose(pos[j("HandRight")], [0.17, -0.2, 2.5])   # a full forearm away: as proposed
+    pos, st = _standing_pose()   # from an elbow by the shoulder the forearm's direction is unknown: left as seen
+    st[[j("ElbowLeft"), j("WristLeft"), j("HandLeft")]] = INFERRED
+    props.positions[j("ElbowLeft")] = [-0.2, 0.36, 2.45]
+    props.positions[j("HandLeft")] = [-0.3, 0.22, 2.45]
+    part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    assert np.allclose(pos[j("ElbowLeft")], [-0.2, 0.36, 2.45])
+    assert np.allclose(pos[j("HandLeft")], [-0.3, 0.22, 2.45])
