@@ -10,8 +10,8 @@ line from the elbow. ARMS = "chain" instead moves only the arm joints the fit do
 calibrated bone lengths. Knees take confident proposals as found (the class-balanced forest's knee parts lie
 about 8 cm from the SDK's knees on real legs; the first forest's sat 28 cm low), except for a performer turned
 well away, where the forest confuses the legs' sides; hips never do (their parts' centres are not the SDK's
-hip joints); feet do when no floor was found. Settings chosen on the real-depth benchmark's subjects 1-2 within the synthetic
-benchmark's bound (docs/depth_tracking.md).
+hip joints); feet do when no floor was found. Settings chosen on the real-depth benchmark's subjects 1-2
+within the synthetic benchmark's bound (docs/depth_tracking.md).
 """
 from __future__ import annotations
 
@@ -55,7 +55,6 @@ FEET_TRACKED = True         # without a floor, a foot on a confident proposal (T
 ELBOW_REACH = (0.85, 1.45)  # less confident elbow proposal to shoulder, in upper arms (the SDK's upper arm is 1.1-1.2 of ours)
 FOREARM_MIN = 1.0           # a hand proposal nearer its elbow than this share of elbow-to-hand is moved out to it
 ELBOW_HAND_MIN = 0.6        # an elbow proposal nearer its hand's than this many forearms is refused
-ANKLES_TRACKED = False      # an ankle moved with a foot on its own confident part is reported tracked
 KNEES = True                # knees from confident proposals (a forest whose knee parts are right on real legs)
 KNEES_TRACKED = True        # ... reported tracked from TRACK_CONFIDENCE where within AGREE of the fit's knee
 FEET_APART = 0.08           # m: foot proposals nearer each other than this are one foot seen twice
@@ -244,10 +243,6 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
     own[[f for f in feet if FEET_TRACKED and conf[f] >= TRACK_CONFIDENCE]] = True
     st[knees] = TRACKED   # a knee on its own confident part, where the fit put it too, is seen
     own[knees] = True
-    if ANKLES_TRACKED:    # an ankle carried with its foot onto the foot's own part
-        for s in SIDES:
-            if own[J(f"Foot{s}")]:
-                st[J(f"Ankle{s}")], own[J(f"Ankle{s}")] = TRACKED, True
     if not chain:   # a wrist placed from its hand and elbow is no surer than they are
         for s in SIDES:
             el, wr, ha = (J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand"))
