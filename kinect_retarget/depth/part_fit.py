@@ -122,15 +122,15 @@ def _usable(conf, p, pos, st, no_floor: bool, in_view, chain: bool, height=None)
         arms = np.array([n.startswith(("Elbow", "Hand")) for n in KINECT_V1.joints]) & (st != TRACKED)
         sure |= arms & (conf >= DOUBTED_ARM_CONFIDENCE)
     ok = sure & near & in_view
-    if not chain:   # a less confident elbow proposal lies about an upper arm from its shoulder (not a part
-        for s in SIDES:   # seen beside it)
-            k = J(f"Elbow{s}")
-            ratio = np.linalg.norm(p[k] - pos[J(f"Shoulder{s}")]) / (bm.UPPER_ARM * (height or 1.7))
-            ok[k] &= bool(conf[k] >= USE_CONFIDENCE or ELBOW_REACH[0] <= ratio <= ELBOW_REACH[1])
-    if not chain:   # an elbow proposal by its own hand's is a hand part taken for the elbow (the forearm is
-        for s in SIDES:   # rigid): with a hand on the face the class-balanced forest saw one there, 24 cm off
+    if not chain:
+        h = height or 1.7
+        for s in SIDES:
             el, ha = J(f"Elbow{s}"), J(f"Hand{s}")
-            ok[el] &= not (ok[ha] and np.linalg.norm(p[el] - p[ha]) < ELBOW_HAND_MIN * bm.FOREARM * (height or 1.7))
+            # a less confident elbow proposal lies about an upper arm from its shoulder (not a part seen beside it)
+            ok[el] &= bool(conf[el] >= USE_CONFIDENCE or _in_elbow_reach(p[el], pos[J(f"Shoulder{s}")], h))
+            # one by its own hand's is a hand part taken for the elbow (the forearm is rigid): with a hand on the
+            # face the class-balanced forest saw one there, 24 cm off
+            ok[el] &= not (ok[ha] and np.linalg.norm(p[el] - p[ha]) < ELBOW_HAND_MIN * bm.FOREARM * h)
     if ONLY_INFERRED and chain:
         arms = [J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand") for s in SIDES]
         ok[arms] &= st[arms] != TRACKED
@@ -139,6 +139,12 @@ def _usable(conf, p, pos, st, no_floor: bool, in_view, chain: bool, height=None)
             j, k = J(f"{n}{s}"), J(f"{n}{o}")
             ok[j] &= bool(np.linalg.norm(p[j] - pos[k]) > move[j]) or (ARM_REACH and st[j] != TRACKED and st[k] != TRACKED)
     return ok
+
+
+def _in_elbow_reach(elbow: np.ndarray, shoulder: np.ndarray, height: float) -> bool:
+    """The elbow lies ELBOW_REACH upper arms from its shoulder (where an elbow can be)."""
+    ratio = np.linalg.norm(elbow - shoulder) / (bm.UPPER_ARM * height)
+    return bool(ELBOW_REACH[0] <= ratio <= ELBOW_REACH[1])
 
 
 def _arm_chain(pos, st, p, conf, use, s, height) -> None:
@@ -162,10 +168,10 @@ def _arm_direct(pos, st, p, conf, use, s, height) -> None:
     if use[ha]:
         pos[ha], st[ha] = p[ha], _state(conf[ha])
         reach = (bm.FOREARM + WRIST_BEFORE_HAND) * height   # elbow to hand joint, the forearm being rigid
-        upper = np.linalg.norm(pos[el] - pos[J(f"Shoulder{s}")]) / (bm.UPPER_ARM * height)
         # a hand part seen only up the forearm, from an elbow where an elbow can be (from one by the shoulder
         # the forearm's direction is unknown: real frames nearer than any training image put hands off the body)
-        if np.linalg.norm(pos[ha] - pos[el]) < FOREARM_MIN * reach and ELBOW_REACH[0] <= upper <= ELBOW_REACH[1]:
+        if (np.linalg.norm(pos[ha] - pos[el]) < FOREARM_MIN * reach
+                and _in_elbow_reach(pos[el], pos[J(f"Shoulder{s}")], height)):
             pos[ha] = pos[el] + _unit(pos[ha] - pos[el]) * reach
         pos[wr] = pos[ha] - _unit(pos[ha] - pos[el]) * WRIST_BEFORE_HAND * height
         st[wr] = _state(min(conf[el], conf[ha]))
@@ -222,7 +228,7 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
         if use[j]:
             pos[j], st[j] = p[j], _state(conf[j])
     feet: list[int] = []
-    knees: list[int] = []
+    knees: list[int] = []   # knees placed on their proposals
     for s in SIDES:
         (_arm_chain if chain else _arm_direct)(pos, st, p, conf, use, s, height)
         if (FEET or no_floor) and _foot(pos, st, p, conf, in_view, s, height, frame):
@@ -230,19 +236,19 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
         k = J(f"Knee{s}")
         if KNEES and use[k] and not turned:   # turned, the forest confuses the legs' sides as it does the arms'
             pos[k], st[k] = p[k], _state(conf[k])
-            if KNEES_TRACKED and conf[k] >= TRACK_CONFIDENCE and np.linalg.norm(p[k] - before[k]) <= AGREE:
-                knees.append(k)   # the forest's knee and the fit's agree
+            knees.append(k)
     # the fit's tracked joints stay tracked where the proposal agrees with them
     moved = np.linalg.norm(pos - before, axis=1)
     st[(before_st == TRACKED) & (moved <= AGREE)] = TRACKED
     if not PROMOTE:
         st[(before_st == TRACKED) & (moved > AGREE)] = INFERRED
-    if FEET_TRACKED:   # both feet's parts seen apart and within the legs' reach: as sure as the SDK's feet
-        st[[f for f in feet if conf[f] >= TRACK_CONFIDENCE]] = TRACKED
+    # joints seen on their own confident part, reported tracked whatever the limb above them says: feet (both
+    # feet's parts apart and within the legs' reach: as sure as the SDK's feet) and knees where the fit agrees
+    seen = [f for f in feet if FEET_TRACKED and conf[f] >= TRACK_CONFIDENCE]
+    seen += [k for k in knees if KNEES_TRACKED and conf[k] >= TRACK_CONFIDENCE and moved[k] <= AGREE]
+    st[seen] = TRACKED
     own = np.zeros(20, bool)
-    own[[f for f in feet if FEET_TRACKED and conf[f] >= TRACK_CONFIDENCE]] = True
-    st[knees] = TRACKED   # a knee on its own confident part, where the fit put it too, is seen
-    own[knees] = True
+    own[seen] = True
     if not chain:   # a wrist placed from its hand and elbow is no surer than they are
         for s in SIDES:
             el, wr, ha = (J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand"))
