@@ -1,4 +1,5 @@
-"""Fixtures in the shape real files come in, from a take shipped in the repository (so no ../shared needed).
+"""Fixtures in the shape real files come in, from a take shipped in the repository (nothing outside the
+repository is needed).
 
 MSRC-12's own files stamp frames with a microsecond-like counter (642926216, ~33,150 per frame, jittered)
 and start with about 20 rows of zeros before the skeleton is found; columns are space-separated. This
