@@ -25,6 +25,7 @@ sys.path.insert(0, str(REPO))
 from kinect_retarget.core.skeletons import KINECT_V1, NOT_TRACKED  # noqa: E402
 from kinect_retarget.sim.depth_scoring import facing_angle, score  # noqa: E402
 from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence  # noqa: E402
+from kinect_retarget.depth.sdk_joints import to_sdk_joints  # noqa: E402
 from kinect_retarget.depth.skeleton_tracker import SkeletonTracker, TrackerSettings  # noqa: E402
 
 from _common import shared_data_or_skip  # noqa: E402
@@ -168,7 +169,7 @@ def main() -> None:
         for p, h in zip(present, have):
             run_ = run_ + 1 if (p and not h) else 0
             late.append(run_)
-        hip_err = np.linalg.norm(pos[:, 0] - gt[:, 0], axis=-1)
+        hip_err = np.linalg.norm(pos[:, 0] - to_sdk_joints(gt)[:, 0], axis=-1)   # the output's convention
         on_main = np.mean(hip_err[have & present] < 0.3) if np.any(have & present) else 0.0
         print(f"{name}: mean error {sc.mean_error * 100:.1f} | on the main person {on_main * 100:.0f} % of frames "
               f"| coverage {sc.coverage * 100:.0f} % | longest wait for a skeleton {max(late) / 30:.2f} s "

@@ -3,6 +3,8 @@
     tracker = SkeletonTracker()
     positions, states = tracker.update(depth_mm, timestamp_seconds)   # (20, 3) metres, (20,) 0/1/2
 
+The joints are where the Kinect SDK puts them (sdk_joints.py), so a tracked take reads like a recorded one.
+
 Safe for any input: a frame of the wrong size or type, all zeros or all "no reading" gives every joint
 NOT_TRACKED (and `tracker.status` says why), never an exception or NaN. Runs on the caller's thread (a
 device thread may call it; it never touches bpy).
@@ -21,6 +23,7 @@ from .confidence import ConfidenceCheck
 from .part_fit import apply_proposals, body_frame, disagreeing
 from .part_forest import MODEL_PATH, load_forest
 from .part_proposals import propose
+from .sdk_joints import to_sdk_joints
 from .segmentation import DepthGrid, FloorPlane, PersonMask, find_people, fit_floor
 from .skeleton_fit import FitResult, fit_person
 
@@ -135,7 +138,7 @@ class SkeletonTracker:
         self._person_centroid, self._last_seen = person.centroid, ts
         self.last_mask, self.last_good = person.mask, fit
         self.status = "tracking" if self.calibration.frames else "tracking (calibrating)"
-        return pos, st
+        return to_sdk_joints(pos), st   # the fit's history stays on its own (MakeHuman's) convention
 
     def _lose(self, ts: float) -> None:
         if self._last_seen is None or not np.isfinite(ts) or ts - self._last_seen > LOST_RESET_S:

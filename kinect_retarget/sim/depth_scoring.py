@@ -6,6 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.skeletons import KINECT_V1, NOT_TRACKED, TRACKED
+from ..depth.sdk_joints import to_sdk_joints
 
 _PAIRS = [(KINECT_V1.index(f"{p}Left"), KINECT_V1.index(f"{p}Right")) for p in ("Hand", "Foot", "Elbow", "Knee")]
 
@@ -37,6 +38,9 @@ def facing_angle(gt: np.ndarray) -> np.ndarray:
 
 
 def score(positions: np.ndarray, states: np.ndarray, gt: np.ndarray, present: np.ndarray) -> Score:
+    """`gt`: the rendered body's joints on MakeHuman's skeleton; the tracker reports the SDK's, so they are
+    compared where the SDK would put them on that body (depth/sdk_joints.py)."""
+    gt = to_sdk_joints(gt)
     has = np.any(states != NOT_TRACKED, axis=1) & present
     nan_frames = int(np.sum(~np.all(np.isfinite(positions), axis=(1, 2))))
     err = np.linalg.norm(positions - gt, axis=-1)

@@ -6,6 +6,7 @@ import pytest
 
 from kinect_retarget.core.skeletons import NOT_TRACKED, TRACKED
 from kinect_retarget.sim.depth_scoring import score
+from kinect_retarget.depth.sdk_joints import to_sdk_joints
 from kinect_retarget.depth.skeleton_tracker import SkeletonTracker, track_depth_frames
 
 
@@ -55,7 +56,7 @@ def test_bad_frame_in_the_middle_then_recovery(rendered):
     assert np.all(st == NOT_TRACKED)
     pos, st = tr.update(seq.mm[5], seq.times[5])
     assert np.all(st != NOT_TRACKED)
-    assert np.linalg.norm(pos[0] - seq.joints[5, 0]) < 0.12
+    assert np.linalg.norm(pos[0] - to_sdk_joints(seq.joints[5])[0]) < 0.12
 
 
 def test_feet_out_of_the_image_are_not_claimed(rendered, camera):
@@ -114,5 +115,5 @@ def test_pre_segmented_frames_without_floor_or_gravity(rendered):
     pos = np.stack([tracker.update(f, t)[0] for f, t in zip(mm, seq.times)])
     assert tracker.floor is None and tracker.calibration.frames > 0
     assert 1.5 < tracker.calibration.height < 1.8, tracker.calibration.height
-    err = np.linalg.norm(pos - seq.joints, axis=-1)
+    err = np.linalg.norm(pos - to_sdk_joints(seq.joints), axis=-1)
     assert err.mean() < 0.08, err.mean()

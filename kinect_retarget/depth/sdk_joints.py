@@ -1,0 +1,50 @@
+"""Where the Kinect v1 SDK puts the torso's joints on a body, from where MakeHuman's skeleton puts them.
+
+The tracker fits MakeHuman's skeleton (its body model, proposals and offsets are learned on MakeHuman bodies);
+the SDK names the same joints but places several elsewhere. Its HipCenter sits well above the hip joints' line
+(about a fifth of the torso; MakeHuman's is on it), its Spine a short way above that (MakeHuman's is mid-back),
+its hip joints are narrower (Kinect v2's, redistributable, are 10 % of standing height apart: tools/
+measure_sdk_proportions.py; MakeHuman's 13 %) and its shoulders a little lower and narrower. Output in the
+SDK's convention means a depth-tracked take is read, retargeted and compared like one the SDK recorded.
+
+The amounts are fractions of the torso (the hips' midpoint to ShoulderCenter), so the same function converts
+the tracker's output and a rendered body's true joints alike (the synthetic benchmark scores against those).
+The spine joints were chosen on the real-depth benchmark's subjects 1-2 (trial 1) and hold on subjects 3-4,
+not tuned on (docs/depth_tracking.md); they are settings, not a model of that data.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.skeletons import KINECT_V1
+
+J = KINECT_V1.index
+HIP_CENTER_UP = 0.20     # HipCenter above the hip joints' midpoint, along the torso
+SPINE_UP = 0.14          # Spine above HipCenter
+HIPS_INWARD = 0.30       # hip joints moved this share of the way toward the midline
+HIPS_UP = 0.06
+SHOULDERS_INWARD = 0.05  # shoulders moved this share of the way toward ShoulderCenter
+SHOULDERS_UP = -0.06
+
+
+def to_sdk_joints(positions: np.ndarray) -> np.ndarray:
+    """(..., 20, 3) Kinect v1 joints on MakeHuman's convention -> the same body's joints where the SDK puts
+    them (a copy; limbs, head, ShoulderCenter unchanged)."""
+    p = np.array(positions, dtype=np.float64, copy=True)
+    hips = (p[..., J("HipLeft"), :] + p[..., J("HipRight"), :]) / 2
+    axis = p[..., J("ShoulderCenter"), :] - hips
+    torso = np.linalg.norm(axis, axis=-1, keepdims=True)
+    up = axis / np.maximum(torso, 1e-9)
+    step = torso * up   # the torso's length along its own axis
+
+    def toward(joint: int, centre: np.ndarray, share: float, rise: float) -> None:
+        side = p[..., joint, :] - centre
+        side -= np.sum(side * up, axis=-1, keepdims=True) * up   # across the torso only
+        p[..., joint, :] += -share * side + rise * step
+
+    for s in ("Left", "Right"):
+        toward(J(f"Hip{s}"), hips, HIPS_INWARD, HIPS_UP)
+        toward(J(f"Shoulder{s}"), p[..., J("ShoulderCenter"), :], SHOULDERS_INWARD, SHOULDERS_UP)
+    p[..., J("HipCenter"), :] = hips + HIP_CENTER_UP * step
+    p[..., J("Spine"), :] = p[..., J("HipCenter"), :] + SPINE_UP * step
+    return p

@@ -1,0 +1,55 @@
+"""The SDK's torso convention: what moves, by how much, and that the tracker reports it."""
+from __future__ import annotations
+
+import numpy as np
+
+from kinect_retarget.core.skeletons import KINECT_V1
+from kinect_retarget.depth import sdk_joints
+from kinect_retarget.depth.sdk_joints import to_sdk_joints
+
+J = KINECT_V1.index
+MOVED = [J(n) for n in ("HipCenter", "Spine", "HipLeft", "HipRight", "ShoulderLeft", "ShoulderRight")]
+
+
+def _random_rotation(rng):
+    q = rng.normal(size=4)
+    w, x, y, z = q / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def test_only_the_torso_joints_move_and_by_the_stated_amounts(rendered):
+    seq, _ = rendered
+    mh = seq.joints[:5]
+    sdk = to_sdk_joints(mh)
+    keep = np.setdiff1d(np.arange(20), MOVED)
+    np.testing.assert_array_equal(sdk[:, keep], mh[:, keep])
+    hips = (mh[:, J("HipLeft")] + mh[:, J("HipRight")]) / 2
+    axis = mh[:, J("ShoulderCenter")] - hips
+    np.testing.assert_allclose(sdk[:, J("HipCenter")], hips + sdk_joints.HIP_CENTER_UP * axis, atol=1e-12)
+    np.testing.assert_allclose(sdk[:, J("Spine")] - sdk[:, J("HipCenter")], sdk_joints.SPINE_UP * axis, atol=1e-12)
+    width = lambda p, a, b: np.linalg.norm(p[:, J(a)] - p[:, J(b)], axis=-1)
+    np.testing.assert_allclose(width(sdk, "HipLeft", "HipRight"),
+                               (1 - sdk_joints.HIPS_INWARD) * width(mh, "HipLeft", "HipRight"), rtol=0.02)
+    assert np.all(width(sdk, "ShoulderLeft", "ShoulderRight") < width(mh, "ShoulderLeft", "ShoulderRight"))
+
+
+def test_the_same_on_a_moved_turned_body_and_the_input_is_left_alone(rendered):
+    seq, _ = rendered
+    mh = seq.joints[3]
+    before = mh.copy()
+    rot, shift = _random_rotation(np.random.default_rng(7)), np.array([0.4, -0.2, 1.1])
+    np.testing.assert_allclose(to_sdk_joints(mh @ rot.T + shift), to_sdk_joints(mh) @ rot.T + shift, atol=1e-12)
+    np.testing.assert_array_equal(mh, before)
+
+
+def test_the_tracker_reports_the_sdk_hip_centre_not_makehumans(rendered):
+    from kinect_retarget.depth.skeleton_tracker import track_depth_frames
+    seq, _ = rendered
+    take = track_depth_frames(seq.mm, seq.times, gravity=seq.gravity)
+    frames = np.arange(take.frame_count)
+    hc = take.positions[frames, J("HipCenter")]
+    to_sdk = np.linalg.norm(hc - to_sdk_joints(seq.joints[frames])[:, J("HipCenter")], axis=-1).mean()
+    to_mh = np.linalg.norm(hc - seq.joints[frames, J("HipCenter")], axis=-1).mean()
+    assert to_sdk < 0.05 and to_mh > to_sdk + 0.04, (to_sdk, to_mh)
