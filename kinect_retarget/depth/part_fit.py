@@ -60,6 +60,8 @@ KNEES_TRACKED = True        # ... reported tracked from TRACK_CONFIDENCE where w
 FEET_APART = 0.08           # m: foot proposals nearer each other than this are one foot seen twice
 NO_OFFSET = ("AnkleLeft", "AnkleRight", "FootLeft", "FootRight", "KneeLeft", "KneeRight")   # proposals used as found (see below)
 DISAGREE = 0.15             # m from a confident proposal beyond which a joint is reported inferred
+SEEN_WITHIN = 0.15          # m: a joint moved onto its confident proposal no farther than this is reported tracked
+SEEN = np.array([n.startswith(("Shoulder", "Elbow", "Wrist", "Hand", "Knee", "Ankle")) for n in KINECT_V1.joints])
 # joints whose proposals check the fit's states (not hips, knees or spine: the fit's states stand for those)
 CHECKED = np.array([not n.startswith(("Hip", "Knee", "Spine")) for n in KINECT_V1.joints])
 OUTWARD = np.array([1.0 if "Left" in n else -1.0 if "Right" in n else 0.0 for n in KINECT_V1.joints])
@@ -259,6 +261,26 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
         if moved[J(f"Elbow{s}")] > AGREE:
             doubt[[J(f"Wrist{s}"), J(f"Hand{s}")]] = True
     return doubt, own
+
+
+def seen_on_parts(before: np.ndarray, pos: np.ndarray, props, frame: np.ndarray | None, own: np.ndarray,
+                  turned: bool) -> np.ndarray:
+    """(20,) bool: joints to report tracked as the SDK does, for a joint it sees: moved onto a confident
+    proposal of their own part (apply_proposals: `before` -> `pos`) no farther than SEEN_WITHIN from where the
+    fit had them, so the forest and the fit agree on the limb. On real depth those joints lay 7-8 cm from the
+    SDK's (farther moves, or a confident proposal left unused, 10-48 cm). A wrist goes with its seen hand, an
+    ankle with its foot placed on its own part (`own`: both moved together). Not for a performer turned away,
+    where the forest confuses the sides. For the reported states only: the fit's history keeps its own."""
+    seen = np.zeros(20, bool)
+    if turned:
+        return seen
+    moved = np.linalg.norm(pos - before, axis=1)
+    on_part = np.linalg.norm(pos - joint_positions(props, frame), axis=1) < 1e-6
+    seen = SEEN & on_part & (moved > 0) & (moved <= SEEN_WITHIN) & (props.confidence >= TRACK_CONFIDENCE)
+    for s in SIDES:
+        seen[J(f"Wrist{s}")] = seen[J(f"Hand{s}")] and moved[J(f"Wrist{s}")] <= SEEN_WITHIN
+        seen[J(f"Ankle{s}")] = own[J(f"Foot{s}")]
+    return seen
 
 
 def disagreeing(pos: np.ndarray, props, frame: np.ndarray | None) -> np.ndarray:

@@ -20,7 +20,7 @@ from ..core.take import Take
 from .body_model_fit import BodyCalibration
 from .depth_camera import DepthCamera
 from .confidence import ConfidenceCheck
-from .part_fit import apply_proposals, body_frame, disagreeing
+from .part_fit import apply_proposals, body_frame, disagreeing, seen_on_parts
 from .part_forest import MODEL_PATH, load_forest
 from .part_proposals import propose
 from .sdk_joints import to_sdk_joints
@@ -119,12 +119,15 @@ class SkeletonTracker:
             self.last_proposals = propose(self.forest, grid, person.mask)
             rc = grid.to_pixel(fit.positions)   # a limb the fit continued past the image's edge keeps its end
             in_view = np.all((rc >= 0) & (rc < np.array(grid.z.shape) - 1), axis=1)
+            frame, turned, before = body_frame(fit.lateral, fit.axis), fit.turned or fit.edge_on, fit.positions.copy()
             doubt, own = apply_proposals(fit.positions, fit.states, self.last_proposals, self.calibration.height,
-                                         no_floor=self.floor is None, in_view=in_view,
-                                         frame=body_frame(fit.lateral, fit.axis), turned=fit.turned or fit.edge_on)
+                                         no_floor=self.floor is None, in_view=in_view, frame=frame, turned=turned)
+            seen = seen_on_parts(before, fit.positions, self.last_proposals, frame, own, turned)
         else:
-            doubt = own = np.zeros(20, bool)
-        pos, st = fit.positions, self.confidence.assess(fit.positions, fit.states, fit, own)
+            doubt = own = seen = np.zeros(20, bool)
+        report = fit.states.copy()   # what is reported; the fit's history keeps its own states
+        report[seen] = TRACKED
+        pos, st = fit.positions, self.confidence.assess(fit.positions, report, fit, own)
         if self.forest is not None:   # reported states only (the fit's history keeps its own)
             doubt |= disagreeing(pos, self.last_proposals, body_frame(fit.lateral, fit.axis))
             st[doubt & (st == TRACKED)] = INFERRED

@@ -249,3 +249,23 @@ def test_a_hand_part_seen_only_up_the_forearm_is_moved_out_to_the_forearm_length
     part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
     assert np.allclose(pos[j("ElbowLeft")], [-0.2, 0.36, 2.45])
     assert np.allclose(pos[j("HandLeft")], [-0.3, 0.22, 2.45])
+
+
+def test_joints_moved_onto_their_confident_part_nearby_are_seen(no_offsets):
+    """An elbow the fit doubted, moved 8 cm onto its confident part, is reported tracked (the wrist with its
+    hand); one moved 25 cm is not (the fit and the forest disagree), nor a weak part, nor a turned performer."""
+    pos, st = _standing_pose()
+    st[[j("ElbowLeft"), j("WristLeft"), j("HandLeft"), j("ElbowRight")]] = INFERRED
+    props = _proposals(pos)
+    props.positions[j("ElbowLeft")] += [0.0, 0.08, 0.0]
+    props.positions[j("HandLeft")] += [0.0, 0.06, 0.0]
+    props.positions[j("ElbowRight")] += [0.0, 0.25, 0.0]
+    before = pos.copy()
+    _, own = part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    seen = part_fit.seen_on_parts(before, pos, props, FACING, own, turned=False)
+    assert seen[[j("ElbowLeft"), j("HandLeft"), j("WristLeft")]].all()
+    assert np.allclose(pos[j("ElbowRight")], props.positions[j("ElbowRight")]) and not seen[j("ElbowRight")]
+    assert not seen[[j("Head"), j("ShoulderLeft")]].any()   # not moved: nothing new was seen
+    assert not part_fit.seen_on_parts(before, pos, props, FACING, own, turned=True).any()
+    props.confidence[:] = part_fit.TRACK_CONFIDENCE / 2
+    assert not part_fit.seen_on_parts(before, pos, props, FACING, own, turned=False)[j("ElbowLeft")]
