@@ -5,7 +5,8 @@ run after the fit, catch the cases where that evidence was misleading, as the SD
 disagrees with the motion of the previous frames (a torso patch that slid, an extremity handed to the wrong
 limb), a limb joint that projects off the person or in front of the surface (occluded, or placed where the
 body is not), every limb when the torso is seen edge-on (a narrow chest: the sides overlap in depth) or fewer
-than three of the five extremities show (side-on, curled up: what was found may be labelled wrongly), the hips
+than three of the five extremities show, to the fit or the body-part forest (side-on, curled up: what was
+found may be labelled wrongly), the hips
 when the head is not seen (the torso was then placed from the shoulders alone), the limbs of a person just
 found (the fit settles over the first frames), and a joint that only just recovered from being flagged (one
 good frame is not yet evidence).
@@ -69,9 +70,10 @@ class ConfidenceCheck:
         a, b = self._history[-2], self._history[-1]
         return b + VELOCITY_DAMPING * (b - a)
 
-    def assess(self, positions: np.ndarray, states: np.ndarray, fit, own=None) -> np.ndarray:
+    def assess(self, positions: np.ndarray, states: np.ndarray, fit, own=None, ends_seen=frozenset()) -> np.ndarray:
         """States after the checks (never promotes a joint). `fit` is the frame's FitResult; `own` ((20,) bool):
-        joints placed on their own evidence (a foot on its body-part proposal), not hanging on the limb above."""
+        joints placed on their own evidence (a foot on its body-part proposal), not hanging on the limb above;
+        `ends_seen`: extremities ("head", "HandLeft", ...) the body-part forest saw, counted with the fit's."""
         st = states.copy()
         doubt = np.zeros(20, bool)
         pred = self.predict()
@@ -85,7 +87,9 @@ class ConfidenceCheck:
         found = {label for label, _ in getattr(fit, "extrema", [])}
         if "head" not in found:   # the torso was placed from the shoulder tops alone: the hips are far from it
             doubt[LOWER_TORSO] = True
-        if len(found) < MIN_EXTREMITIES:   # not the shape of a person facing the sensor (side-on, curled up)
+        # not the shape of a person facing the sensor (side-on, curled up); a hand against the body is no
+        # geodesic extremity, but the forest sees it
+        if len(found | set(ends_seen)) < MIN_EXTREMITIES:
             doubt[LIMB + SIDE_TORSO] = True
         for chain in CHAINS:   # beyond a doubtful joint the chain hangs on a guess
             bad = np.cumsum(doubt[chain]) > 0   # (an elbow the fit merely inferred leaves the hand its own evidence)

@@ -283,6 +283,13 @@ def seen_on_parts(before: np.ndarray, pos: np.ndarray, props, frame: np.ndarray 
     return seen
 
 
+def ends_seen(props) -> frozenset:
+    """The extremities (head, hands, feet; labelled as the fit labels its own) whose parts the forest saw
+    confidently: on real depth, hands held against the body are no geodesic extremity but are seen."""
+    ends = {"head": "Head", **{f"{n}{s}": f"{n}{s}" for n in ("Hand", "Foot") for s in SIDES}}
+    return frozenset(label for label, joint in ends.items() if props.confidence[J(joint)] >= TRACK_CONFIDENCE)
+
+
 def disagreeing(pos: np.ndarray, props, frame: np.ndarray | None) -> np.ndarray:
     """(20,) bool: joints left far from a confident proposal of their own part (the fit's evidence and the
     forest's disagree: not to be reported tracked); a wrist goes with its hand. For the reported states only:

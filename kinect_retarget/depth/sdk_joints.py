@@ -3,14 +3,15 @@
 The tracker fits MakeHuman's skeleton (its body model, proposals and offsets are learned on MakeHuman bodies);
 the SDK names the same joints but places several elsewhere. Its HipCenter sits well above the hip joints' line
 (about a fifth of the torso; MakeHuman's is on it), its Spine a short way above that (MakeHuman's is mid-back),
-its hip joints are narrower (Kinect v2's, redistributable, are 10 % of standing height apart: tools/
-measure_sdk_proportions.py; MakeHuman's 13 %) and its shoulders a little lower and narrower. Output in the
+its hip joints are narrower (Kinect v2's, in the redistributable recordings, are 0.099 of standing height
+apart; MakeHuman's 0.132) and its shoulders a little lower and narrower. Output in the
 SDK's convention means a depth-tracked take is read, retargeted and compared like one the SDK recorded.
 
 The amounts are fractions of the torso (the hips' midpoint to ShoulderCenter), so the same function converts
 the tracker's output and a rendered body's true joints alike (the synthetic benchmark scores against those).
-The spine joints were chosen on the real-depth benchmark's subjects 1-2 (trial 1) and hold on subjects 3-4,
-not tuned on (docs/depth_tracking.md); they are settings, not a model of that data.
+The hips' width comes from the Kinect v2 recordings; the rest (no redistributable Kinect v1 skeleton shows
+them) are five settings chosen on the real-depth benchmark's subjects 1-2, trial 1, as its other settings
+were, and they hold on subjects 3-4, not tuned on (docs/depth_tracking.md).
 """
 from __future__ import annotations
 
@@ -21,7 +22,7 @@ from ..core.skeletons import KINECT_V1
 J = KINECT_V1.index
 HIP_CENTER_UP = 0.20     # HipCenter above the hip joints' midpoint, along the torso
 SPINE_UP = 0.14          # Spine above HipCenter
-HIPS_INWARD = 0.30       # hip joints moved this share of the way toward the midline
+HIPS_INWARD = 0.25       # hip joints moved this share of the way toward the midline (1 - 0.099 / 0.132)
 HIPS_UP = 0.06
 SHOULDERS_INWARD = 0.05  # shoulders moved this share of the way toward ShoulderCenter
 SHOULDERS_UP = -0.06

@@ -20,7 +20,7 @@ from ..core.take import Take
 from .body_model_fit import BodyCalibration
 from .depth_camera import DepthCamera
 from .confidence import ConfidenceCheck
-from .part_fit import apply_proposals, body_frame, disagreeing, seen_on_parts
+from .part_fit import apply_proposals, body_frame, disagreeing, ends_seen, seen_on_parts
 from .part_forest import MODEL_PATH, load_forest
 from .part_proposals import propose
 from .sdk_joints import to_sdk_joints
@@ -123,11 +123,13 @@ class SkeletonTracker:
             doubt, own = apply_proposals(fit.positions, fit.states, self.last_proposals, self.calibration.height,
                                          no_floor=self.floor is None, in_view=in_view, frame=frame, turned=turned)
             seen = seen_on_parts(before, fit.positions, self.last_proposals, frame, own, turned)
+            ends = ends_seen(self.last_proposals)
         else:
             doubt = own = seen = np.zeros(20, bool)
+            ends = frozenset()
         report = fit.states.copy()   # what is reported; the fit's history keeps its own states
         report[seen] = TRACKED
-        pos, st = fit.positions, self.confidence.assess(fit.positions, report, fit, own)
+        pos, st = fit.positions, self.confidence.assess(fit.positions, report, fit, own, ends)
         if self.forest is not None:   # reported states only (the fit's history keeps its own)
             doubt |= disagreeing(pos, self.last_proposals, body_frame(fit.lateral, fit.axis))
             st[doubt & (st == TRACKED)] = INFERRED

@@ -112,3 +112,20 @@ def test_a_turn_unsteadies_the_facing_until_it_has_faced_the_sensor_again(rng):
         assert not chk.facing_steady
     chk.assess(pose, tracked, facing)
     assert chk.facing_steady
+
+
+def test_extremities_the_forest_saw_count_with_the_fits(rng):
+    """Hands held against the body are no geodesic extremity: with the head and one foot found by the fit and
+    a hand seen by the body-part forest, three extremities show and the limbs keep their states."""
+    from kinect_retarget.depth.part_fit import TRACK_CONFIDENCE, ends_seen
+    chk, pose, tracked = _steady(rng)
+    conf = np.zeros(20)
+    conf[J("HandRight")] = TRACK_CONFIDENCE
+    conf[J("FootLeft")] = TRACK_CONFIDENCE / 2   # not confident: not seen
+    ends = ends_seen(SimpleNamespace(confidence=conf))
+    assert ends == {"HandRight"}
+    st = chk.assess(pose, tracked, _fit([("head", None), ("FootRight", None)]), ends_seen=ends)
+    assert np.all(st == TRACKED)
+    chk.remember(pose)
+    st = chk.assess(pose, tracked, _fit([("head", None), ("FootRight", None)]))   # without it: two of five
+    assert st[J("ElbowLeft")] == INFERRED
