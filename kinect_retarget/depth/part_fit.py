@@ -60,6 +60,7 @@ KNEES_TRACKED = True        # ... reported tracked from TRACK_CONFIDENCE where w
 FEET_APART = 0.08           # m: foot proposals nearer each other than this are one foot seen twice
 NO_OFFSET = ("AnkleLeft", "AnkleRight", "FootLeft", "FootRight", "KneeLeft", "KneeRight")   # proposals used as found (see below)
 DISAGREE = 0.15             # m from a confident proposal beyond which a joint is reported inferred
+KNEE_NEAR_PART = True       # ... and a knee whose foot is on its own part and whose confident part is as near
 SEEN_WITHIN = 0.15          # m: a joint moved onto its confident proposal no farther than this is reported tracked
 SEEN = np.array([n.startswith(("Shoulder", "Elbow", "Wrist", "Hand", "Knee", "Ankle")) for n in KINECT_V1.joints])
 # joints whose proposals check the fit's states (not hips, knees or spine: the fit's states stand for those)
@@ -269,17 +270,23 @@ def seen_on_parts(before: np.ndarray, pos: np.ndarray, props, frame: np.ndarray 
     proposal of their own part (apply_proposals: `before` -> `pos`) no farther than SEEN_WITHIN from where the
     fit had them, so the forest and the fit agree on the limb. On real depth those joints lay 7-8 cm from the
     SDK's (farther moves, or a confident proposal left unused, 10-48 cm). A wrist goes with its seen hand, an
-    ankle with its foot placed on its own part (`own`: both moved together). Not for a performer turned away,
-    where the forest confuses the sides. For the reported states only: the fit's history keeps its own."""
+    ankle with its foot placed on its own part (`own`: both moved together), and a knee whose confident part
+    lies within SEEN_WITHIN where that foot is seen (the leg's end and middle both seen: 8 cm from the SDK's).
+    Not for a performer turned away, where the forest confuses the sides. For the reported states only: the
+    fit's history keeps its own."""
     seen = np.zeros(20, bool)
     if turned:
         return seen
     moved = np.linalg.norm(pos - before, axis=1)
-    on_part = np.linalg.norm(pos - joint_positions(props, frame), axis=1) < 1e-6
-    seen = SEEN & on_part & (moved > 0) & (moved <= SEEN_WITHIN) & (props.confidence >= TRACK_CONFIDENCE)
+    off_part = np.linalg.norm(pos - joint_positions(props, frame), axis=1)
+    confident = props.confidence >= TRACK_CONFIDENCE
+    seen = SEEN & (off_part < 1e-6) & (moved > 0) & (moved <= SEEN_WITHIN) & confident
     for s in SIDES:
         seen[J(f"Wrist{s}")] = seen[J(f"Hand{s}")] and moved[J(f"Wrist{s}")] <= SEEN_WITHIN
         seen[J(f"Ankle{s}")] = own[J(f"Foot{s}")]
+        k = J(f"Knee{s}")
+        if KNEE_NEAR_PART:
+            seen[k] |= bool(own[J(f"Foot{s}")] and confident[k] and off_part[k] <= SEEN_WITHIN)
     return seen
 
 

@@ -269,3 +269,20 @@ def test_joints_moved_onto_their_confident_part_nearby_are_seen(no_offsets):
     assert not part_fit.seen_on_parts(before, pos, props, FACING, own, turned=True).any()
     props.confidence[:] = part_fit.TRACK_CONFIDENCE / 2
     assert not part_fit.seen_on_parts(before, pos, props, FACING, own, turned=False)[j("ElbowLeft")]
+
+
+def test_a_knee_between_a_seen_foot_and_its_confident_part_is_seen(no_offsets):
+    """A knee the proposals did not move is seen where its leg's foot lies on its own part and the knee's
+    confident part is within 15 cm; 20 cm away, or with the foot not on its own part, it is not."""
+    pos, _ = _standing_pose()
+    props = _proposals(pos)
+    props.positions[j("KneeLeft")] += [0.0, 0.08, 0.0]
+    props.positions[j("KneeRight")] += [0.0, 0.20, 0.0]
+    own = np.zeros(20, bool)
+    own[[j("FootLeft"), j("FootRight")]] = True
+    seen = part_fit.seen_on_parts(pos, pos, props, FACING, own, turned=False)
+    assert seen[j("KneeLeft")] and not seen[j("KneeRight")]
+    assert seen[[j("AnkleLeft"), j("AnkleRight")]].all()   # with their feet
+    own[j("FootLeft")] = False
+    seen = part_fit.seen_on_parts(pos, pos, props, FACING, own, turned=False)
+    assert not seen[[j("KneeLeft"), j("AnkleLeft")]].any()
