@@ -34,6 +34,7 @@ VELOCITY_DAMPING = 0.5   # a fraction of the last frame's velocity is carried on
 MIN_EXTREMITIES = 3      # of head, hands and feet; fewer and the labelling of what was found is a guess
 WARMUP_FRAMES = 6        # frames after (re)acquisition during which limbs are reported inferred (0.2 s)
 RECOVERY_FRAMES = 1      # frames a joint stays flagged after its checks pass again
+RECOVER_SEEN_AT_ONCE = True   # ... unless both the fit and the forest see it in this frame
 LIMB_DEPTH_INSIDE = np.array([bm.DEPTH_INSIDE[KINECT_V1.joints[j].replace("Left", "").replace("Right", "")]
                               for j in LIMB])
 OFF_SURFACE = 0.2        # Projector.cost at or above this: off the person's silhouette or well in front of it
@@ -70,10 +71,13 @@ class ConfidenceCheck:
         a, b = self._history[-2], self._history[-1]
         return b + VELOCITY_DAMPING * (b - a)
 
-    def assess(self, positions: np.ndarray, states: np.ndarray, fit, own=None, ends_seen=frozenset()) -> np.ndarray:
+    def assess(self, positions: np.ndarray, states: np.ndarray, fit, own=None, ends_seen=frozenset(),
+               fresh=None) -> np.ndarray:
         """States after the checks (never promotes a joint). `fit` is the frame's FitResult; `own` ((20,) bool):
         joints placed on their own evidence (a foot on its body-part proposal), not hanging on the limb above;
-        `ends_seen`: extremities ("head", "HandLeft", ...) the body-part forest saw, counted with the fit's."""
+        `ends_seen`: extremities ("head", "HandLeft", ...) the body-part forest saw, counted with the fit's;
+        `fresh` ((20,) bool): joints seen anew this frame (on their own part, where the fit had them), which
+        need no recovery frame once their checks pass."""
         st = states.copy()
         doubt = np.zeros(20, bool)
         pred = self.predict()
@@ -100,7 +104,10 @@ class ConfidenceCheck:
         if self._frames <= WARMUP_FRAMES:   # a person just found: limbs settle over the first frames
             doubt[LIMB] = True
         self._flag_age = np.where(doubt, 0, self._flag_age + 1)
-        st[(self._flag_age <= RECOVERY_FRAMES) & (st == TRACKED)] = INFERRED
+        recovering = (self._flag_age <= RECOVERY_FRAMES) & ~doubt
+        if fresh is not None and RECOVER_SEEN_AT_ONCE:
+            recovering &= ~fresh
+        st[(doubt | recovering) & (st == TRACKED)] = INFERRED
         return st
 
     def remember(self, positions: np.ndarray) -> None:

@@ -129,7 +129,7 @@ class SkeletonTracker:
             ends = frozenset()
         report = fit.states.copy()   # what is reported; the fit's history keeps its own states
         report[seen] = TRACKED
-        pos, st = fit.positions, self.confidence.assess(fit.positions, report, fit, own, ends)
+        pos, st = fit.positions, self.confidence.assess(fit.positions, report, fit, own, ends, seen)
         if self.forest is not None:   # reported states only (the fit's history keeps its own)
             doubt |= disagreeing(pos, self.last_proposals, body_frame(fit.lateral, fit.axis))
             st[doubt & (st == TRACKED)] = INFERRED

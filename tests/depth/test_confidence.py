@@ -129,3 +129,17 @@ def test_extremities_the_forest_saw_count_with_the_fits(rng):
     chk.remember(pose)
     st = chk.assess(pose, tracked, _fit([("head", None), ("FootRight", None)]))   # without it: two of five
     assert st[J("ElbowLeft")] == INFERRED
+
+
+def test_a_joint_seen_anew_needs_no_recovery_frame(rng):
+    """After a flagged frame, an elbow both the fit and the forest see again is tracked at once; the rest of
+    its chain, not seen anew, waits its recovery frame."""
+    chk, pose, tracked = _steady(rng)
+    jumped = pose.copy()
+    jumped[J("ElbowLeft")] += [0.4, 0.0, 0.0]
+    chk.assess(jumped, tracked, _fit())
+    chk.remember(pose)
+    fresh = np.zeros(20, bool)
+    fresh[J("ElbowLeft")] = True
+    st = chk.assess(pose, tracked, _fit(), fresh=fresh)
+    assert st[J("ElbowLeft")] == TRACKED and st[J("HandLeft")] == INFERRED
