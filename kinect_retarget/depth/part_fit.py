@@ -265,10 +265,11 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
 
 
 def seen_on_parts(before: np.ndarray, pos: np.ndarray, props, frame: np.ndarray | None, own: np.ndarray,
-                  turned: bool) -> np.ndarray:
+                  turned: bool, before_states: np.ndarray | None = None) -> np.ndarray:
     """(20,) bool: joints to report tracked as the SDK does, for a joint it sees: moved onto a confident
     proposal of their own part (apply_proposals: `before` -> `pos`) no farther than SEEN_WITHIN from where the
-    fit had them, so the forest and the fit agree on the limb. On real depth those joints lay 7-8 cm from the
+    fit had them (AGREE where the fit tracked it, `before_states`: moved farther, it was demoted for the fit
+    and the forest disagreeing), so both agree on the limb. On real depth those joints lay 7-8 cm from the
     SDK's (farther moves, or a confident proposal left unused, 10-48 cm). A wrist goes with its seen hand, an
     ankle with its foot placed on its own part (`own`: both moved together), and a knee whose confident part
     lies within SEEN_WITHIN where that foot is seen (the leg's end and middle both seen: 8 cm from the SDK's).
@@ -280,9 +281,13 @@ def seen_on_parts(before: np.ndarray, pos: np.ndarray, props, frame: np.ndarray 
     moved = np.linalg.norm(pos - before, axis=1)
     off_part = np.linalg.norm(pos - joint_positions(props, frame), axis=1)
     confident = props.confidence >= TRACK_CONFIDENCE
-    seen = SEEN & (off_part < 1e-6) & (moved > 0) & (moved <= SEEN_WITHIN) & confident
+    within = np.full(20, SEEN_WITHIN)
+    if before_states is not None:
+        within[before_states == TRACKED] = AGREE
+    seen = SEEN & (off_part < 1e-6) & (moved > 0) & (moved <= within) & confident
     for s in SIDES:
-        seen[J(f"Wrist{s}")] = seen[J(f"Hand{s}")] and moved[J(f"Wrist{s}")] <= SEEN_WITHIN
+        wr = J(f"Wrist{s}")
+        seen[wr] = seen[J(f"Hand{s}")] and moved[wr] <= within[wr]
         seen[J(f"Ankle{s}")] = own[J(f"Foot{s}")]
         k = J(f"Knee{s}")
         if KNEE_NEAR_PART:

@@ -119,10 +119,11 @@ class SkeletonTracker:
             self.last_proposals = propose(self.forest, grid, person.mask)
             rc = grid.to_pixel(fit.positions)   # a limb the fit continued past the image's edge keeps its end
             in_view = np.all((rc >= 0) & (rc < np.array(grid.z.shape) - 1), axis=1)
-            frame, turned, before = body_frame(fit.lateral, fit.axis), fit.turned or fit.edge_on, fit.positions.copy()
+            frame, turned = body_frame(fit.lateral, fit.axis), fit.turned or fit.edge_on
+            before, before_st = fit.positions.copy(), fit.states.copy()
             doubt, own = apply_proposals(fit.positions, fit.states, self.last_proposals, self.calibration.height,
                                          no_floor=self.floor is None, in_view=in_view, frame=frame, turned=turned)
-            seen = seen_on_parts(before, fit.positions, self.last_proposals, frame, own, turned)
+            seen = seen_on_parts(before, fit.positions, self.last_proposals, frame, own, turned, before_st)
             ends = ends_seen(self.last_proposals)
         else:
             doubt = own = seen = np.zeros(20, bool)

@@ -286,3 +286,18 @@ def test_a_knee_between_a_seen_foot_and_its_confident_part_is_seen(no_offsets):
     own[j("FootLeft")] = False
     seen = part_fit.seen_on_parts(pos, pos, props, FACING, own, turned=False)
     assert not seen[[j("KneeLeft"), j("AnkleLeft")]].any()
+
+
+def test_a_tracked_joint_moved_past_agreement_is_not_seen(no_offsets):
+    """The fit tracked the left elbow; its part lies 12 cm away (beyond AGREE): the proposal moves it, the fit
+    and the forest disagree, and it is not reported seen. Had the fit doubted it, the move would count."""
+    pos, st = _standing_pose()
+    props = _proposals(pos)
+    props.positions[j("ElbowLeft")] += [0.0, 0.12, 0.0]
+    before, before_st = pos.copy(), st.copy()
+    _, own = part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    assert np.allclose(pos[j("ElbowLeft")], props.positions[j("ElbowLeft")])
+    assert not part_fit.seen_on_parts(before, pos, props, FACING, own, False, before_st)[j("ElbowLeft")]
+    doubted = before_st.copy()
+    doubted[j("ElbowLeft")] = INFERRED
+    assert part_fit.seen_on_parts(before, pos, props, FACING, own, False, doubted)[j("ElbowLeft")]

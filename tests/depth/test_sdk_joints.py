@@ -1,4 +1,4 @@
-"""The SDK's torso convention: what moves, by how much, and that the tracker reports it."""
+"""The SDK's joint conventions: what moves, by how much, and that the tracker reports it."""
 from __future__ import annotations
 
 import numpy as np
@@ -8,7 +8,8 @@ from kinect_retarget.depth import sdk_joints
 from kinect_retarget.depth.sdk_joints import to_sdk_joints
 
 J = KINECT_V1.index
-MOVED = [J(n) for n in ("HipCenter", "Spine", "HipLeft", "HipRight", "ShoulderLeft", "ShoulderRight")]
+MOVED = [J(n) for n in ("HipCenter", "Spine", "HipLeft", "HipRight", "ShoulderLeft", "ShoulderRight", "ElbowLeft",
+                        "ElbowRight", "WristLeft", "WristRight", "HandLeft", "HandRight")]
 
 
 def _random_rotation(rng):
@@ -19,7 +20,7 @@ def _random_rotation(rng):
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
-def test_only_the_torso_joints_move_and_by_the_stated_amounts(rendered):
+def test_only_the_torso_and_arm_joints_move_and_by_the_stated_amounts(rendered):
     seq, _ = rendered
     mh = seq.joints[:5]
     sdk = to_sdk_joints(mh)
@@ -33,6 +34,12 @@ def test_only_the_torso_joints_move_and_by_the_stated_amounts(rendered):
     np.testing.assert_allclose(width(sdk, "HipLeft", "HipRight"),
                                (1 - sdk_joints.HIPS_INWARD) * width(mh, "HipLeft", "HipRight"), rtol=0.02)
     assert np.all(width(sdk, "ShoulderLeft", "ShoulderRight") < width(mh, "ShoulderLeft", "ShoulderRight"))
+    torso = np.linalg.norm(axis, axis=-1)
+    for s in ("Left", "Right"):   # the forearm and hand moved out along the upper arm, unchanged in shape
+        upper = mh[:, J(f"Elbow{s}")] - mh[:, J(f"Shoulder{s}")]
+        out = upper / np.linalg.norm(upper, axis=-1, keepdims=True) * (sdk_joints.ARM_OUT * torso)[:, None]
+        for n in ("Elbow", "Wrist", "Hand"):
+            np.testing.assert_allclose(sdk[:, J(f"{n}{s}")] - mh[:, J(f"{n}{s}")], out, atol=1e-12)
 
 
 def test_the_same_on_a_moved_turned_body_and_the_input_is_left_alone(rendered):
