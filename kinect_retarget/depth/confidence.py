@@ -6,10 +6,10 @@ disagrees with the motion of the previous frames (a torso patch that slid, an ex
 limb), a limb joint that projects off the person or in front of the surface (occluded, or placed where the
 body is not), every limb when the torso is seen edge-on (a narrow chest: the sides overlap in depth) or fewer
 than three of the five extremities show, to the fit or the body-part forest (side-on, curled up: what was
-found may be labelled wrongly), the hips
-when the head is not seen (the torso was then placed from the shoulders alone), the limbs of a person just
-found (the fit settles over the first frames), and a joint that only just recovered from being flagged (one
-good frame is not yet evidence).
+found may be labelled wrongly), the hips when the head is not seen (the torso was then placed from the
+shoulders alone), the limbs of a person just found (the fit settles over the first frames), and a joint that
+only just recovered from being flagged (one good frame is not yet evidence, unless the fit and the forest
+both see it again).
 """
 from __future__ import annotations
 

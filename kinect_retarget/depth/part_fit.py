@@ -62,7 +62,8 @@ NO_OFFSET = ("AnkleLeft", "AnkleRight", "FootLeft", "FootRight", "KneeLeft", "Kn
 DISAGREE = 0.15             # m from a confident proposal beyond which a joint is reported inferred
 KNEE_NEAR_PART = True       # ... and a knee whose foot is on its own part and whose confident part is as near
 SEEN_WITHIN = 0.15          # m: a joint moved onto its confident proposal no farther than this is reported tracked
-SEEN = np.array([n.startswith(("Shoulder", "Elbow", "Wrist", "Hand", "Knee", "Ankle")) for n in KINECT_V1.joints])
+# joints seen on their own part (wrists and ankles go with their hands and feet: seen_on_parts)
+SEEN = np.array([n.startswith(("Shoulder", "Elbow", "Hand", "Knee")) for n in KINECT_V1.joints])
 # joints whose proposals check the fit's states (not hips, knees or spine: the fit's states stand for those)
 CHECKED = np.array([not n.startswith(("Hip", "Knee", "Spine")) for n in KINECT_V1.joints])
 OUTWARD = np.array([1.0 if "Left" in n else -1.0 if "Right" in n else 0.0 for n in KINECT_V1.joints])

@@ -1,18 +1,19 @@
-"""Where the Kinect v1 SDK puts the torso's joints on a body, from where MakeHuman's skeleton puts them.
+"""Where the Kinect v1 SDK puts the torso's and arms' joints on a body, from where MakeHuman's skeleton puts them.
 
 The tracker fits MakeHuman's skeleton (its body model, proposals and offsets are learned on MakeHuman bodies);
 the SDK names the same joints but places several elsewhere. Its HipCenter sits well above the hip joints' line
 (about a fifth of the torso; MakeHuman's is on it), its Spine a short way above that (MakeHuman's is mid-back),
 its hip joints are narrower (Kinect v2's, in the redistributable recordings, are 0.099 of standing height
 apart; MakeHuman's 0.132), its shoulders a little lower and narrower, and its upper arm longer (Kinect v2's
-0.152 of standing height, MakeHuman's 0.137: the elbow, wrist and hand sit that much farther out along it). Output in the
-SDK's convention means a depth-tracked take is read, retargeted and compared like one the SDK recorded.
+0.152 of standing height, MakeHuman's 0.137: elbow, wrist and hand sit that much farther out along it).
+Output in the SDK's convention means a depth-tracked take is read, retargeted and compared like one the SDK
+recorded.
 
 The amounts are fractions of the torso (the hips' midpoint to ShoulderCenter), so the same function converts
 the tracker's output and a rendered body's true joints alike (the synthetic benchmark scores against those).
-The hips' width and the upper arm come from the Kinect v2 recordings; the rest (no redistributable Kinect v1 skeleton shows
-them) are five settings chosen on the real-depth benchmark's subjects 1-2, trial 1, as its other settings
-were, and they hold on subjects 3-4, not tuned on (docs/depth_tracking.md).
+The hips' width and the upper arm come from the Kinect v2 recordings; the other five numbers (no
+redistributable Kinect v1 skeleton shows them) are settings chosen on the real-depth benchmark's subjects 1-2,
+trial 1, as its other settings were, and they hold on subjects 3-4, not tuned on (docs/depth_tracking.md).
 """
 from __future__ import annotations
 
