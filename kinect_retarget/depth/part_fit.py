@@ -276,9 +276,8 @@ def seen_on_parts(before: np.ndarray, pos: np.ndarray, props, frame: np.ndarray 
     lies within SEEN_WITHIN where that foot is seen (the leg's end and middle both seen: 8 cm from the SDK's).
     Not for a performer turned away, where the forest confuses the sides. For the reported states only: the
     fit's history keeps its own."""
-    seen = np.zeros(20, bool)
     if turned:
-        return seen
+        return np.zeros(20, bool)
     moved = np.linalg.norm(pos - before, axis=1)
     off_part = np.linalg.norm(pos - joint_positions(props, frame), axis=1)
     confident = props.confidence >= TRACK_CONFIDENCE

@@ -127,12 +127,12 @@ class SkeletonTracker:
             ends = ends_seen(self.last_proposals)
         else:
             doubt = own = seen = np.zeros(20, bool)
-            ends = frozenset()
+            ends, frame = frozenset(), None
         report = fit.states.copy()   # what is reported; the fit's history keeps its own states
         report[seen] = TRACKED
         pos, st = fit.positions, self.confidence.assess(fit.positions, report, fit, own, ends, seen)
         if self.forest is not None:   # reported states only (the fit's history keeps its own)
-            doubt |= disagreeing(pos, self.last_proposals, body_frame(fit.lateral, fit.axis))
+            doubt |= disagreeing(pos, self.last_proposals, frame)
             st[doubt & (st == TRACKED)] = INFERRED
         self._calibrate(person, fit, up)
         if self._prev is not None and self.settings.smoothing > 0:
