@@ -17,6 +17,7 @@ import numpy as np
 
 from ..core.skeletons import INFERRED, KINECT_V1, TRACKED
 from ..core.take import Take
+from .arm_reach import fold_overreaching_hands
 from .body_model_fit import BodyCalibration
 from .depth_camera import DepthCamera
 from .confidence import ConfidenceCheck
@@ -144,7 +145,10 @@ class SkeletonTracker:
         self._person_centroid, self._last_seen = person.centroid, ts
         self.last_mask, self.last_good = person.mask, fit
         self.status = "tracking" if self.calibration.frames else "tracking (calibrating)"
-        return to_sdk_joints(pos), st   # the fit's history stays on its own (MakeHuman's) convention
+        out = to_sdk_joints(pos)   # the fit's history stays on its own (MakeHuman's) convention
+        fold_overreaching_hands(out, st, None if self.forest is None else self.last_proposals.positions,
+                                self.calibration.height)
+        return out, st
 
     def _lose(self, ts: float) -> None:
         if self._last_seen is None or not np.isfinite(ts) or ts - self._last_seen > LOST_RESET_S:
