@@ -2,7 +2,7 @@
 import numpy as np
 
 from kinect_retarget.core.skeletons import INFERRED, KINECT_V1, TRACKED
-from kinect_retarget.depth.arm_reach import ELBOW_TO_HAND, fold_overreaching_hands
+from kinect_retarget.depth.arm_reach import ELBOW_TO_HAND, HandSpeedGate, fold_overreaching_hands
 
 J = KINECT_V1.index
 H = 1.75
@@ -45,3 +45,35 @@ def test_hands_within_reach_or_tracked_are_left_alone():
     before = p.copy()
     assert not fold_overreaching_hands(p, st, None, H).any()
     np.testing.assert_array_equal(p, before)
+
+
+def _run_gate(hand_left_path, tracked_at=()):
+    """Feed a standing performer whose left hand follows `hand_left_path` (one point a 30 Hz frame)."""
+    gate = HandSpeedGate()
+    out = []
+    for i, hand in enumerate(hand_left_path):
+        p, st = standing()
+        p[J("HandLeft")] = hand
+        if i in tracked_at:
+            st[J("HandLeft")] = TRACKED
+        gate.apply(p, st, i / 30.0)
+        out.append(p[J("HandLeft")].copy())
+    return np.array(out)
+
+
+def test_a_hand_jumping_onto_another_part_is_held_for_a_few_frames_only():
+    p, _ = standing()
+    rest, away = p[J("HandLeft")], p[J("HandRight")] + [0.0, 0.3, -0.2]   # 60 cm off in one frame
+    out = _run_gate([rest] * 5 + [away] * 10)
+    np.testing.assert_allclose(out[5:10], np.repeat(rest[None], 5, axis=0))   # held 5 frames (HOLD_S)...
+    np.testing.assert_allclose(out[10:], np.repeat(away[None], 5, axis=0))    # ... then what is seen is taken
+
+
+def test_a_jump_back_or_a_tracked_or_slow_hand_is_taken():
+    p, _ = standing()
+    rest, away = p[J("HandLeft")], p[J("HandLeft")] + [0.6, 0.0, 0.0]
+    back = _run_gate([rest] * 3 + [away] * 3 + [rest] * 3, tracked_at={3})   # the jump out was seen on its part
+    np.testing.assert_allclose(back[3:6], np.repeat(away[None], 3, axis=0))
+    np.testing.assert_allclose(back[6:], np.repeat(rest[None], 3, axis=0))   # back where it was: taken
+    slow = [rest + [0.03 * k, 0.0, 0.0] for k in range(10)]   # 3 cm a frame
+    np.testing.assert_allclose(_run_gate(slow), np.array(slow))
