@@ -1,5 +1,5 @@
-"""Hands reported beyond their forearm's reach, or faster than a hand moves, are brought back (reported joints
-only).
+"""Hands reported beyond their forearm's reach, and arms moving faster than arms move, are brought back (reported
+joints only).
 
 On real depth the fit sometimes gives a hand to an extremity of the other arm, or the forest labels the other
 hand, crossing the body, as this one: the elbow stays near its place and the hand lands half a metre from it
@@ -8,10 +8,11 @@ so such a hand is reported at forearm's length from its elbow: on its own part's
 reach, else hanging below the elbow, where an arm the fit lost most often is. Joints the fit reports tracked
 are left alone, and the fit's history keeps its own pose.
 
-Likewise a hand that jumps farther in a frame than a hand moves: the SDK's own hands on the real benchmark step
-more than 35 cm in a 30 Hz frame in 0.25 % of frames, the tracker's did in 4 % (the forest or the fit taking
-another part for the hand for a few frames). Such a hand keeps its last place relative to its elbow for up to
-HOLD_S, then follows what is seen again.
+Likewise an arm none of whose joints is tracked, one of which jumps farther in a frame than arms move: on the
+real benchmark the SDK's own elbows step more than 20 cm in a 30 Hz frame in 0.2 % of frames, the tracker's in
+4 % (the forest or the fit taking another part for the arm for a few frames). Such an arm keeps its last place
+relative to its shoulder for up to HOLD_S, then follows what is seen again; a jump back to where it was in
+the last RETURN_S (the arm leaving a mistake) is taken at once.
 """
 from __future__ import annotations
 
@@ -25,10 +26,11 @@ J = KINECT_V1.index
 ELBOW_TO_HAND = bm.FOREARM + SDK_HAND   # of standing height (the SDK's elbow to hand)
 REACH_MAX = 1.45 * ELBOW_TO_HAND        # no hand is farther from its elbow than this
 PROPOSAL_REACH = (0.1, 0.21)            # a hand proposal this far from the elbow is a hand on this forearm
-MAX_HAND_SPEED = 10.5   # m/s (35 cm in a 30 Hz frame)
-HOLD_S = 0.15           # a hand is held at most this long (5 frames at 30 Hz) before what is seen is taken
+MAX_ARM_SPEED = 7.5     # m/s (25 cm in a 30 Hz frame)
+HOLD_S = 0.15           # an arm is held at most this long (5 frames at 30 Hz) before what is seen is taken
 GAP_S = 0.2             # frames farther apart than this are not compared
-RETURN_S = 0.5          # a jump back to where the hand was (relative to its elbow) this recently is taken ...
+SETTLE_FRAMES = 5       # nothing is held until this many frames were seen (the first fits settle)
+RETURN_S = 0.5          # a jump back to where the arm was (relative to its shoulder) this recently is taken ...
 RETURN_NEAR = 0.15      # ... within this many metres: the hand leaving a mistake, not making one
 
 
@@ -55,9 +57,10 @@ def fold_overreaching_hands(positions: np.ndarray, states: np.ndarray, proposals
     return moved
 
 
-class HandSpeedGate:
-    """Holds an untracked hand (and its wrist) that moved faster than MAX_HAND_SPEED at its last place
-    relative to its elbow, for up to HOLD_S in a row. Call `apply` on each frame's reported joints."""
+class ArmSpeedGate:
+    """Holds an untracked arm (elbow, wrist and hand) of which a joint moved faster than MAX_ARM_SPEED relative
+    to its shoulder at its last place there, for up to HOLD_S in a row. Call `apply` on each frame's reported
+    joints."""
 
     def __init__(self):
         self.reset()
@@ -66,26 +69,28 @@ class HandSpeedGate:
         self._last: np.ndarray | None = None
         self._time = float("nan")
         self._held = {"Left": 0.0, "Right": 0.0}
-        self._recent: list[tuple[float, np.ndarray]] = []   # (time, hands relative to their elbows (2, 3))
+        self._recent: list[tuple[float, np.ndarray]] = []   # (time, arms relative to their shoulders (2, 3, 3))
 
     def apply(self, positions: np.ndarray, states: np.ndarray, timestamp: float) -> np.ndarray:
-        """Move, in place, the hands that jumped. Returns the hands held."""
+        """Move, in place, the arms that jumped. Returns the joints held."""
         held = np.zeros(20, bool)
         dt = timestamp - self._time
-        if self._last is not None and 0.0 < dt <= GAP_S:
+        if self._last is not None and 0.0 < dt <= GAP_S and len(self._recent) >= SETTLE_FRAMES:
             for i, s in enumerate(("Left", "Right")):
-                e, w, h = J(f"Elbow{s}"), J(f"Wrist{s}"), J(f"Hand{s}")
-                jumped = np.linalg.norm(positions[h] - self._last[h]) > MAX_HAND_SPEED * dt
-                back = any(np.linalg.norm(positions[h] - positions[e] - r[i]) < RETURN_NEAR for _, r in self._recent)
-                if states[h] != TRACKED and jumped and not back and self._held[s] < HOLD_S:
-                    positions[h] = positions[e] + self._last[h] - self._last[e]
-                    positions[w] = positions[e] + self._last[w] - self._last[e]
+                root, arm = J(f"Shoulder{s}"), [J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand")]
+                step = np.linalg.norm(positions[arm] - self._last[arm], axis=1).max()
+                rel = positions[arm] - positions[root]
+                back = any(np.linalg.norm(rel - r[i], axis=1).max() < RETURN_NEAR for _, r in self._recent)
+                seen = bool(np.any(states[arm] == TRACKED))
+                if step > MAX_ARM_SPEED * dt and not (seen or back) and self._held[s] < HOLD_S:
+                    positions[arm] = positions[root] + self._last[arm] - self._last[root]
                     self._held[s] += dt
-                    held[h] = True
+                    held[arm] = True
                 else:
                     self._held[s] = 0.0
         if np.isfinite(timestamp):
             self._last, self._time = positions.copy(), float(timestamp)
-            rel = np.array([positions[J(f"Hand{s}")] - positions[J(f"Elbow{s}")] for s in ("Left", "Right")])
+            rel = np.array([positions[[J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand")]] - positions[J(f"Shoulder{s}")]
+                            for s in ("Left", "Right")])
             self._recent = [(t, r) for t, r in self._recent if 0.0 < timestamp - t <= RETURN_S] + [(timestamp, rel)]
         return held

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..core.skeletons import INFERRED, KINECT_V1, TRACKED
 from ..core.take import Take
-from .arm_reach import HandSpeedGate, fold_overreaching_hands
+from .arm_reach import ArmSpeedGate, fold_overreaching_hands
 from .body_model_fit import BodyCalibration
 from .depth_camera import DepthCamera
 from .confidence import ConfidenceCheck
@@ -69,7 +69,7 @@ class SkeletonTracker:
         self.last_mask: np.ndarray | None = None
         self.last_good: FitResult | None = None
         self.last_proposals = None
-        self.hand_gate = HandSpeedGate()
+        self.arm_gate = ArmSpeedGate()
 
     def set_gravity(self, gravity) -> None:
         """Accelerometer reading (any scale), pointing down in camera space."""
@@ -149,7 +149,7 @@ class SkeletonTracker:
         out = to_sdk_joints(pos)   # the fit's history stays on its own (MakeHuman's) convention
         fold_overreaching_hands(out, st, None if self.forest is None else self.last_proposals.positions,
                                 self.calibration.height)
-        self.hand_gate.apply(out, st, ts)
+        self.arm_gate.apply(out, st, ts)
         return out, st
 
     def _lose(self, ts: float) -> None:

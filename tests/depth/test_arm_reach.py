@@ -1,8 +1,8 @@
-"""A hand reported beyond its forearm's reach is brought back to it (arm_reach.py)."""
+"""Hands beyond their forearm's reach, and arms faster than arms move, are brought back (arm_reach.py)."""
 import numpy as np
 
 from kinect_retarget.core.skeletons import INFERRED, KINECT_V1, TRACKED
-from kinect_retarget.depth.arm_reach import ELBOW_TO_HAND, HandSpeedGate, fold_overreaching_hands
+from kinect_retarget.depth.arm_reach import ELBOW_TO_HAND, ArmSpeedGate, fold_overreaching_hands
 
 J = KINECT_V1.index
 H = 1.75
@@ -49,7 +49,7 @@ def test_hands_within_reach_or_tracked_are_left_alone():
 
 def _run_gate(hand_left_path, tracked_at=()):
     """Feed a standing performer whose left hand follows `hand_left_path` (one point a 30 Hz frame)."""
-    gate = HandSpeedGate()
+    gate = ArmSpeedGate()
     out = []
     for i, hand in enumerate(hand_left_path):
         p, st = standing()
@@ -67,6 +67,8 @@ def test_a_hand_jumping_onto_another_part_is_held_for_a_few_frames_only():
     out = _run_gate([rest] * 5 + [away] * 10)
     np.testing.assert_allclose(out[5:10], np.repeat(rest[None], 5, axis=0))   # held 5 frames (HOLD_S)...
     np.testing.assert_allclose(out[10:], np.repeat(away[None], 5, axis=0))    # ... then what is seen is taken
+    early = _run_gate([rest] * 2 + [away] * 3)   # the first frames of a fit settle: nothing held
+    np.testing.assert_allclose(early[2:], np.repeat(away[None], 3, axis=0))
 
 
 def test_a_jump_back_or_a_tracked_or_slow_hand_is_taken():
