@@ -20,9 +20,11 @@ import numpy as np
 
 from ..core.skeletons import KINECT_V1, TRACKED
 from . import body_model_fit as bm
-from .part_fit import SDK_HAND
+from .part_fit import SDK_HAND, SIDES
 
 J = KINECT_V1.index
+SHOULDERS = np.array([J(f"Shoulder{s}") for s in SIDES])
+ARMS = np.array([[J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand")] for s in SIDES])   # below each shoulder
 ELBOW_TO_HAND = bm.FOREARM + SDK_HAND   # of standing height (the SDK's elbow to hand)
 REACH_MAX = 1.45 * ELBOW_TO_HAND        # no hand is farther from its elbow than this
 PROPOSAL_REACH = (0.1, 0.21)            # a hand proposal this far from the elbow is a hand on this forearm
@@ -41,7 +43,7 @@ def fold_overreaching_hands(positions: np.ndarray, states: np.ndarray, proposals
     up = positions[J("ShoulderCenter")] - positions[J("HipCenter")]
     up = up / max(float(np.linalg.norm(up)), 1e-9)
     moved = np.zeros(20, bool)
-    for s in ("Left", "Right"):
+    for s in SIDES:
         e, w, h = J(f"Elbow{s}"), J(f"Wrist{s}"), J(f"Hand{s}")
         if states[h] == TRACKED or np.linalg.norm(positions[h] - positions[e]) <= REACH_MAX * height:
             continue
@@ -68,29 +70,32 @@ class ArmSpeedGate:
     def reset(self) -> None:
         self._last: np.ndarray | None = None
         self._time = float("nan")
-        self._held = {"Left": 0.0, "Right": 0.0}
-        self._recent: list[tuple[float, np.ndarray]] = []   # (time, arms relative to their shoulders (2, 3, 3))
+        self._held = np.zeros(len(SIDES))   # seconds each arm has been held in a row
+        self._recent: list[tuple[float, np.ndarray]] = []   # (time, _relative(positions)) of the last RETURN_S
 
     def apply(self, positions: np.ndarray, states: np.ndarray, timestamp: float) -> np.ndarray:
         """Move, in place, the arms that jumped. Returns the joints held."""
         held = np.zeros(20, bool)
         dt = timestamp - self._time
         if self._last is not None and 0.0 < dt <= GAP_S and len(self._recent) >= SETTLE_FRAMES:
-            for i, s in enumerate(("Left", "Right")):
-                root, arm = J(f"Shoulder{s}"), [J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand")]
+            rel = _relative(positions)
+            for i, (root, arm) in enumerate(zip(SHOULDERS, ARMS)):
                 step = np.linalg.norm(positions[arm] - self._last[arm], axis=1).max()
-                rel = positions[arm] - positions[root]
-                back = any(np.linalg.norm(rel - r[i], axis=1).max() < RETURN_NEAR for _, r in self._recent)
+                back = any(np.linalg.norm(rel[i] - r[i], axis=1).max() < RETURN_NEAR for _, r in self._recent)
                 seen = bool(np.any(states[arm] == TRACKED))
-                if step > MAX_ARM_SPEED * dt and not (seen or back) and self._held[s] < HOLD_S:
+                if step > MAX_ARM_SPEED * dt and not (seen or back) and self._held[i] < HOLD_S:
                     positions[arm] = positions[root] + self._last[arm] - self._last[root]
-                    self._held[s] += dt
+                    self._held[i] += dt
                     held[arm] = True
                 else:
-                    self._held[s] = 0.0
+                    self._held[i] = 0.0
         if np.isfinite(timestamp):
             self._last, self._time = positions.copy(), float(timestamp)
-            rel = np.array([positions[[J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand")]] - positions[J(f"Shoulder{s}")]
-                            for s in ("Left", "Right")])
-            self._recent = [(t, r) for t, r in self._recent if 0.0 < timestamp - t <= RETURN_S] + [(timestamp, rel)]
+            self._recent = [(t, r) for t, r in self._recent if 0.0 < timestamp - t <= RETURN_S]
+            self._recent.append((timestamp, _relative(positions)))
         return held
+
+
+def _relative(positions: np.ndarray) -> np.ndarray:
+    """(2, 3, 3): each arm's elbow, wrist and hand relative to its shoulder."""
+    return positions[ARMS] - positions[SHOULDERS][:, None]
