@@ -32,7 +32,10 @@ PREDICTION_SLACK = np.full(20, 0.25)
 PREDICTION_SLACK[TORSO + SIDE_TORSO] = 0.10
 VELOCITY_DAMPING = 0.5   # a fraction of the last frame's velocity is carried on (prediction, not extrapolation)
 MIN_EXTREMITIES = 3      # of head, hands and feet; fewer and the labelling of what was found is a guess
-WARMUP_FRAMES = 6        # frames after (re)acquisition during which limbs are reported inferred (0.2 s)
+WARMUP_FRAMES = 6        # frames after (re)acquisition before the fit counts as settled (0.2 s)
+# frames after (re)acquisition during which limbs are reported inferred (0.1 s): on real depth the limbs of
+# frames 4-6 lay 3-8 cm from the SDK's, as near as later ones; the first frames have little history to check
+LIMB_WARMUP_FRAMES = 3
 RECOVERY_FRAMES = 1      # frames a joint stays flagged after its checks pass again
 RECOVER_SEEN_AT_ONCE = True   # ... unless both the fit and the forest see it in this frame
 LIMB_DEPTH_INSIDE = np.array([bm.DEPTH_INSIDE[KINECT_V1.joints[j].replace("Left", "").replace("Right", "")]
@@ -101,7 +104,7 @@ class ConfidenceCheck:
         self._frames += 1
         turned = getattr(fit, "turned", False) or getattr(fit, "edge_on", False)
         self._facing_frames = 0 if turned else self._facing_frames + 1
-        if self._frames <= WARMUP_FRAMES:   # a person just found: limbs settle over the first frames
+        if self._frames <= LIMB_WARMUP_FRAMES:   # a person just found: limbs settle over the first frames
             doubt[LIMB] = True
         self._flag_age = np.where(doubt, 0, self._flag_age + 1)
         recovering = (self._flag_age <= RECOVERY_FRAMES) & ~doubt

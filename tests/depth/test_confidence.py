@@ -6,7 +6,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from kinect_retarget.core.skeletons import INFERRED, KINECT_V1, TRACKED
-from kinect_retarget.depth.confidence import LIMB, RECOVERY_FRAMES, WARMUP_FRAMES, ConfidenceCheck
+from kinect_retarget.depth.confidence import LIMB, LIMB_WARMUP_FRAMES, RECOVERY_FRAMES, WARMUP_FRAMES, ConfidenceCheck
 from kinect_retarget.sim.depth_scoring import score
 from kinect_retarget.depth.skeleton_tracker import track_depth_frames
 
@@ -22,7 +22,7 @@ def _steady(rng):
     pose = rng.normal(0.0, 0.3, (20, 3)) + [0.0, 0.0, 2.5]
     chk = ConfidenceCheck()
     tracked = np.full(20, TRACKED, np.uint8)
-    for _ in range(WARMUP_FRAMES + RECOVERY_FRAMES):   # a person just found: limbs settle first
+    for _ in range(max(WARMUP_FRAMES, LIMB_WARMUP_FRAMES + RECOVERY_FRAMES)):   # a person just found: settle first
         chk.assess(pose, tracked, _fit())
         chk.remember(pose)
     for _ in range(3):
@@ -49,7 +49,8 @@ def test_a_joint_that_breaks_the_motion_is_inferred_then_recovers(rng):
 def test_limbs_settle_before_they_are_claimed(rng):
     pose = rng.normal(0.0, 0.3, (20, 3)) + [0.0, 0.0, 2.5]
     chk, tracked = ConfidenceCheck(), np.full(20, TRACKED, np.uint8)
-    for _ in range(WARMUP_FRAMES):
+    assert 0 < LIMB_WARMUP_FRAMES <= WARMUP_FRAMES
+    for _ in range(LIMB_WARMUP_FRAMES):
         st = chk.assess(pose, tracked, _fit())
         chk.remember(pose)
         assert np.all(st[LIMB] == INFERRED) and st[J("Head")] == TRACKED and st[J("HipCenter")] == TRACKED

@@ -103,7 +103,7 @@ def test_turned_performer_moves_only_doubted_arm_joints_as_a_chain(no_offsets):
     assert np.array_equal(pos[j("HandRight")], before[j("HandRight")]) and st[j("HandRight")] == TRACKED
 
 
-def test_feet_without_a_floor_follow_their_proposals_and_refuse_one_foot_seen_twice(no_offsets):
+def test_feet_without_a_floor_follow_their_proposals_together_or_apart(no_offsets):
     pos, st = _standing_pose()
     fit = pos.copy()
     fit[j("FootLeft")] = fit[j("FootRight")] + [0.02, 0, 0]   # the fit put both feet on the right one
@@ -114,7 +114,11 @@ def test_feet_without_a_floor_follow_their_proposals_and_refuse_one_foot_seen_tw
     assert np.allclose(p[j("FootLeft")], pos[j("FootLeft")])
     thigh = np.linalg.norm(p[j("HipLeft")] - p[j("KneeLeft")])   # the knee re-solved with the calibrated thigh
     assert np.isclose(thigh, part_fit.bm.THIGH * 1.7)
-    props.positions[j("FootLeft")] = props.positions[j("FootRight")] + [0.03, 0, 0]   # one foot, both labels
+    props.positions[j("FootLeft")] = props.positions[j("FootRight")] + [-0.03, 0, 0]   # feet together
+    p = fit.copy()
+    part_fit.apply_proposals(p, st.copy(), props, 1.7, no_floor=True, frame=FACING)
+    assert np.allclose(p[j("FootLeft")], props.positions[j("FootLeft")])
+    props.positions[j("FootLeft")] = props.positions[j("FootRight")] + [0.10, 0, 0]   # left of right: crossed
     p = fit.copy()
     s = st.copy()
     s[j("FootLeft")] = INFERRED
@@ -301,3 +305,27 @@ def test_a_tracked_joint_moved_past_agreement_is_not_seen(no_offsets):
     doubted = before_st.copy()
     doubted[j("ElbowLeft")] = INFERRED
     assert part_fit.seen_on_parts(before, pos, props, FACING, own, False, doubted)[j("ElbowLeft")]
+
+
+def test_a_hand_moved_out_along_a_short_forearm_and_a_wrist_on_its_own_part_are_seen(no_offsets):
+    """A hand part seen up the forearm is moved out to the forearm's length (a few cm off its part): still on
+    it, so seen. A wrist whose own confident part lies within 8 cm of it is seen though its hand is not; 12 cm
+    away, or from a weak part, it is not."""
+    pos, st = _standing_pose()
+    st[[j("ElbowLeft"), j("WristLeft"), j("HandLeft")]] = INFERRED
+    props = _proposals(pos)
+    reach = (part_fit.bm.FOREARM + part_fit.WRIST_BEFORE_HAND) * 1.7
+    props.positions[j("HandLeft")] = [-0.17, 0.12 - reach + 0.03, 2.5]   # 3 cm short of the forearm's length
+    before = pos.copy()
+    _, own = part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    assert np.isclose(np.linalg.norm(pos[j("HandLeft")] - props.positions[j("HandLeft")]), 0.03)
+    assert part_fit.seen_on_parts(before, pos, props, FACING, own, turned=False)[j("HandLeft")]
+    pos, _ = _standing_pose()
+    props = _proposals(pos)
+    props.confidence[[j("HandLeft"), j("HandRight")]] = 0.0   # no hand seen
+    props.positions[j("WristLeft")] += [0.0, 0.06, 0.0]
+    props.positions[j("WristRight")] += [0.0, 0.12, 0.0]
+    seen = part_fit.seen_on_parts(pos, pos, props, FACING, np.zeros(20, bool), turned=False)
+    assert seen[j("WristLeft")] and not seen[j("WristRight")] and not seen[[j("HandLeft"), j("HandRight")]].any()
+    props.confidence[j("WristLeft")] = part_fit.WRIST_SEEN_CONFIDENCE / 2
+    assert not part_fit.seen_on_parts(pos, pos, props, FACING, np.zeros(20, bool), turned=False)[j("WristLeft")]
