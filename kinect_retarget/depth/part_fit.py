@@ -68,7 +68,10 @@ HAND_ON_PART = 0.04         # m: a hand this near its part's proposal is on it (
 # agree on it (on the real benchmark's subjects 1-2, wrists 32 -> 52 % tracked, their error 6.9 -> 6.3 cm)
 WRIST_ON_PART, WRIST_SEEN_CONFIDENCE = 0.08, 0.0004
 # joints seen on their own part (wrists and ankles go with their hands and feet: seen_on_parts)
-SEEN = np.array([n.startswith(("Shoulder", "Elbow", "Hand", "Knee")) for n in KINECT_V1.joints])
+SEEN = np.array([n.startswith(("Head", "Shoulder", "Elbow", "Hand", "Knee")) for n in KINECT_V1.joints])
+# ... those taken as proposed (DIRECT) however far the fit had them: on real depth, shoulders the fit tracked
+# 10-25 cm from their confident parts, moved onto them, lay 4-6 cm from the SDK's
+SEEN_ANY_MOVE = np.isin(np.arange(len(KINECT_V1.joints)), [J(n) for n in DIRECT])
 HANDS = [J(f"Hand{s}") for s in SIDES]
 # joints whose proposals check the fit's states (not hips, knees or spine: the fit's states stand for those)
 CHECKED = np.array([not n.startswith(("Hip", "Knee", "Spine")) for n in KINECT_V1.joints])
@@ -278,7 +281,8 @@ def seen_on_parts(before: np.ndarray, pos: np.ndarray, props, frame: np.ndarray 
     """(20,) bool: joints to report tracked as the SDK does, for a joint it sees: moved onto a confident
     proposal of their own part (apply_proposals: `before` -> `pos`) no farther than SEEN_WITHIN from where the
     fit had them (AGREE where the fit tracked it, `before_states`: moved farther, it was demoted for the fit
-    and the forest disagreeing), so both agree on the limb. On real depth those joints lay 7-8 cm from the
+    and the forest disagreeing), so both agree on the limb; the head, shoulder centre and shoulders (DIRECT,
+    the forest's surest parts) however far they moved. On real depth those joints lay 7-8 cm from the
     SDK's (farther moves, or a confident proposal left unused, 10-48 cm). A hand moved out along a forearm seen
     short is on its part within HAND_ON_PART. A wrist goes with its seen hand, or is seen within WRIST_ON_PART
     of its own part's proposal; an ankle goes with its foot placed on its own part (`own`: both moved
@@ -294,6 +298,7 @@ def seen_on_parts(before: np.ndarray, pos: np.ndarray, props, frame: np.ndarray 
     within = np.full(20, SEEN_WITHIN)
     if before_states is not None:
         within[before_states == TRACKED] = AGREE
+    within[SEEN_ANY_MOVE] = MAX_MOVE
     on_part = off_part < 1e-6
     on_part[HANDS] = off_part[HANDS] < HAND_ON_PART
     seen = SEEN & on_part & (moved > 0) & (moved <= within) & confident

@@ -307,6 +307,20 @@ def test_a_tracked_joint_moved_past_agreement_is_not_seen(no_offsets):
     assert part_fit.seen_on_parts(before, pos, props, FACING, own, False, doubted)[j("ElbowLeft")]
 
 
+def test_a_shoulder_or_head_moved_onto_its_part_is_seen_however_far(no_offsets):
+    """The forest's torso-top parts are its surest: a tracked shoulder or head its part moves 20 cm is seen
+    on it (an elbow moved as far is not: test above)."""
+    pos, st = _standing_pose()
+    pos[j("Head")] = [0.0, 0.7, 2.5]
+    props = _proposals(pos)
+    props.positions[j("ShoulderLeft")] += [0.0, 0.2, 0.0]
+    props.positions[j("Head")] += [0.2, 0.0, 0.0]
+    before, before_st = pos.copy(), st.copy()
+    _, own = part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    seen = part_fit.seen_on_parts(before, pos, props, FACING, own, False, before_st)
+    assert seen[[j("ShoulderLeft"), j("Head")]].all() and not seen[j("ShoulderRight")]   # (not moved)
+
+
 def test_a_hand_moved_out_along_a_short_forearm_and_a_wrist_on_its_own_part_are_seen(no_offsets):
     """A hand part seen up the forearm is moved out to the forearm's length (a few cm off its part): still on
     it, so seen. A wrist whose own confident part lies within 8 cm of it is seen though its hand is not; 12 cm
