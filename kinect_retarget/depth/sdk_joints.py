@@ -1,4 +1,4 @@
-"""Where the Kinect v1 SDK puts the torso's, arms' and knees' joints on a body, from where MakeHuman's skeleton puts them.
+"""Where the Kinect v1 SDK puts the torso's, arms' and legs' joints on a body, from where MakeHuman's skeleton puts them.
 
 The tracker fits MakeHuman's skeleton (its body model, proposals and offsets are learned on MakeHuman bodies);
 the SDK names the same joints but places several elsewhere. Its HipCenter sits well above the hip joints' line
@@ -6,14 +6,16 @@ the SDK names the same joints but places several elsewhere. Its HipCenter sits w
 its hip joints are narrower (Kinect v2's, in the redistributable recordings, are 0.099 of standing height
 apart; MakeHuman's 0.132), its shoulders a little lower and narrower, and its upper arm longer (Kinect v2's
 0.152 of standing height, MakeHuman's 0.137: elbow, wrist and hand sit that much farther out along it), and its
-knees a little higher and farther back (its thighs lean about 6 degrees less forward than the tracker's).
+knees a little higher and farther back (its thighs lean about 6 degrees less forward than the tracker's), and
+its ankles higher up the shin and a little farther back (the tracker's lay 4 cm lower and 1-2 cm farther
+forward, median, and its shins leaned about 3 degrees farther forward).
 Output in the SDK's convention means a depth-tracked take is read, retargeted and compared like one the SDK
 recorded.
 
 The amounts are fractions of the torso (the hips' midpoint to ShoulderCenter), so the same function converts
 the tracker's output and a rendered body's true joints alike (the synthetic benchmark scores against those).
 The hips' width and the upper arm come from the Kinect v2 recordings; the other seven numbers (no
-redistributable Kinect v1 skeleton shows them) are settings chosen on the real-depth benchmark's subjects 1-2,
+redistributable Kinect v1 skeleton shows them; nor the ankles' two) are settings chosen on the real-depth benchmark's subjects 1-2,
 trial 1, as its other settings were, and they hold on subjects 3-4, not tuned on (docs/depth_tracking.md).
 """
 from __future__ import annotations
@@ -32,6 +34,8 @@ SHOULDERS_INWARD = 0.05  # shoulders moved this share of the way toward Shoulder
 SHOULDERS_UP = -0.06
 KNEES_BACK = 0.05        # knees moved this much back (the SDK's thighs lean 6 degrees less forward) ...
 KNEES_UP = 0.05          # ... and up
+ANKLES_BACK = 0.03       # ankles moved this much back (1.5 cm on a 0.5 m torso) ...
+ANKLES_UP_SHIN = 0.07    # ... and up along the shin (3.5 cm: the shin's direction is kept)
 SDK_UPPER_ARM = 0.152    # of standing height, Kinect v2 (MakeHuman's bm.UPPER_ARM 0.137)
 TORSO = bm.HEIGHT_SHOULDER_CENTER - bm.HEIGHT_HIP_CENTER   # the torso as a share of standing height
 ARM_OUT = (SDK_UPPER_ARM - bm.UPPER_ARM) / TORSO   # elbow, wrist and hand moved out along the upper arm
@@ -39,7 +43,7 @@ ARM_OUT = (SDK_UPPER_ARM - bm.UPPER_ARM) / TORSO   # elbow, wrist and hand moved
 
 def to_sdk_joints(positions: np.ndarray) -> np.ndarray:
     """(..., 20, 3) Kinect v1 joints on MakeHuman's convention -> the same body's joints where the SDK puts
-    them (a copy; ankles, feet, head, ShoulderCenter unchanged)."""
+    them (a copy; feet, head, ShoulderCenter unchanged)."""
     p = np.array(positions, dtype=np.float64, copy=True)
     hips = (p[..., J("HipLeft"), :] + p[..., J("HipRight"), :]) / 2
     axis = p[..., J("ShoulderCenter"), :] - hips
@@ -61,6 +65,9 @@ def to_sdk_joints(positions: np.ndarray) -> np.ndarray:
     forward = np.cross(left, up)   # the performer's front
     forward /= np.maximum(np.linalg.norm(forward, axis=-1, keepdims=True), 1e-9)
     for s in ("Left", "Right"):
+        shin = p[..., J(f"Knee{s}"), :] - p[..., J(f"Ankle{s}"), :]
+        shin /= np.maximum(np.linalg.norm(shin, axis=-1, keepdims=True), 1e-9)
+        p[..., J(f"Ankle{s}"), :] += (ANKLES_UP_SHIN * shin - ANKLES_BACK * forward) * torso
         p[..., J(f"Knee{s}"), :] += (KNEES_UP * up - KNEES_BACK * forward) * torso
         toward(J(f"Hip{s}"), hips, HIPS_INWARD, HIPS_UP)
         toward(J(f"Shoulder{s}"), p[..., J("ShoulderCenter"), :], SHOULDERS_INWARD, SHOULDERS_UP)

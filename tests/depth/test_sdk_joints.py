@@ -9,7 +9,8 @@ from kinect_retarget.depth.sdk_joints import to_sdk_joints
 
 J = KINECT_V1.index
 MOVED = [J(n) for n in ("HipCenter", "Spine", "HipLeft", "HipRight", "ShoulderLeft", "ShoulderRight", "ElbowLeft",
-                        "ElbowRight", "WristLeft", "WristRight", "HandLeft", "HandRight", "KneeLeft", "KneeRight")]
+                        "ElbowRight", "WristLeft", "WristRight", "HandLeft", "HandRight", "KneeLeft", "KneeRight",
+                        "AnkleLeft", "AnkleRight")]
 
 
 def _random_rotation(rng):
@@ -20,7 +21,7 @@ def _random_rotation(rng):
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
-def test_only_the_torso_arm_and_knee_joints_move_and_by_the_stated_amounts(rendered):
+def test_only_the_torso_arm_knee_and_ankle_joints_move_and_by_the_stated_amounts(rendered):
     seq, _ = rendered
     mh = seq.joints[:5]
     sdk = to_sdk_joints(mh)
@@ -45,6 +46,10 @@ def test_only_the_torso_arm_and_knee_joints_move_and_by_the_stated_amounts(rende
         np.testing.assert_allclose(rise, sdk_joints.KNEES_UP * torso, atol=1e-12)
         facing = np.cross(mh[:, J("HipLeft")] - mh[:, J("HipRight")], up)   # the knee goes back, not forward
         assert np.all(np.sum((sdk[:, J(f"Knee{s}")] - mh[:, J(f"Knee{s}")]) * facing, axis=-1) < 0)
+        shin = mh[:, J(f"Knee{s}")] - mh[:, J(f"Ankle{s}")]   # the ankle goes up its shin and back
+        unit = lambda v: v / np.linalg.norm(v, axis=-1, keepdims=True)
+        np.testing.assert_allclose(sdk[:, J(f"Ankle{s}")] - mh[:, J(f"Ankle{s}")], torso[:, None] * (
+            sdk_joints.ANKLES_UP_SHIN * unit(shin) - sdk_joints.ANKLES_BACK * unit(facing)), atol=1e-12)
 
 
 def test_the_same_on_a_moved_turned_body_and_the_input_is_left_alone(rendered):
