@@ -281,15 +281,14 @@ def seen_on_parts(before: np.ndarray, pos: np.ndarray, props, frame: np.ndarray 
     """(20,) bool: joints to report tracked as the SDK does, for a joint it sees: moved onto a confident
     proposal of their own part (apply_proposals: `before` -> `pos`) no farther than SEEN_WITHIN from where the
     fit had them (AGREE where the fit tracked it, `before_states`: moved farther, it was demoted for the fit
-    and the forest disagreeing), so both agree on the limb; the head, shoulder centre and shoulders (DIRECT,
-    the forest's surest parts) however far they moved. On real depth those joints lay 7-8 cm from the
-    SDK's (farther moves, or a confident proposal left unused, 10-48 cm). A hand moved out along a forearm seen
-    short is on its part within HAND_ON_PART. A wrist goes with its seen hand, or is seen within WRIST_ON_PART
-    of its own part's proposal; an ankle goes with its foot placed on its own part (`own`: both moved
-    together), and a knee is seen whose confident part lies within SEEN_WITHIN where that foot is seen (the
-    leg's end and middle both seen: 8 cm from the SDK's).
-    Not for a performer turned away, where the forest confuses the sides. For the reported states only: the
-    fit's history keeps its own."""
+    and the forest disagreeing), so both agree on the limb. On real depth those joints lay 7-8 cm from the
+    SDK's (farther moves, or a confident proposal left unused, 10-48 cm). The head, shoulder centre and
+    shoulders (DIRECT, the forest's surest parts) are seen however far they moved. A hand moved out along a
+    forearm seen short is on its part within HAND_ON_PART. A wrist goes with its seen hand, or is seen within
+    WRIST_ON_PART of its own part's proposal; an ankle goes with its foot placed on its own part (`own`: both
+    moved together), and a knee is seen whose confident part lies within SEEN_WITHIN where that foot is seen
+    (the leg's end and middle both seen: 8 cm from the SDK's). Not for a performer turned away, where the
+    forest confuses the sides. For the reported states only: the fit's history keeps its own."""
     if turned:
         return np.zeros(20, bool)
     moved = np.linalg.norm(pos - before, axis=1)

@@ -14,8 +14,8 @@ recorded.
 
 The amounts are fractions of the torso (the hips' midpoint to ShoulderCenter), so the same function converts
 the tracker's output and a rendered body's true joints alike (the synthetic benchmark scores against those).
-The hips' width and the upper arm come from the Kinect v2 recordings; the other seven numbers (no
-redistributable Kinect v1 skeleton shows them; nor the ankles' two) are settings chosen on the real-depth benchmark's subjects 1-2,
+The hips' width and the upper arm come from the Kinect v2 recordings; the other nine numbers (no
+redistributable Kinect v1 skeleton shows them) are settings chosen on the real-depth benchmark's subjects 1-2,
 trial 1, as its other settings were, and they hold on subjects 3-4, not tuned on (docs/depth_tracking.md).
 """
 from __future__ import annotations
