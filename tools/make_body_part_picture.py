@@ -29,12 +29,13 @@ def palette() -> np.ndarray:
     return np.clip(rgb, 0, 1) * np.where([p.endswith("_right") for p in PARTS], 0.65, 1.0)[:, None]
 
 
-def picture(frames: list[np.ndarray]) -> np.ndarray:
-    """Track the frames in order; the last one's preview with every classified cell coloured by its part."""
+def picture(frames: list[np.ndarray], times: list[float] | None = None) -> np.ndarray:
+    """Track the frames in order (at `times`, seconds; default 30 frames/s); the last one's preview with every
+    classified cell coloured by its part."""
     part_proposals.MAX_CELLS = 10 ** 6   # every cell coloured (the tracker subsamples large silhouettes)
     tracker = SkeletonTracker()
     for i, mm in enumerate(frames):
-        pos, st = tracker.update(mm, i / 30)
+        pos, st = tracker.update(mm, i / 30 if times is None else times[i])
     img = preview_rgba(frames[-1], None, pos, st, tracker.camera, scale=1)[::-1].copy()
     props, step = tracker.last_proposals, tracker.last_grid.step
     if props is not None:
@@ -60,11 +61,16 @@ def main() -> None:
     sys.path.insert(0, str(REPO / "tests"))
     from repo_data import materialize   # tests/data with its gzipped files decompressed
     from kinect_retarget.device.disparity_calibration import Calibration
+    from kinect_retarget.device.protocol import TIMESTAMP_HZ, ticks_between
     from kinect_retarget.sim.depth_sequences import load_fakenect_dir
     with tempfile.TemporaryDirectory() as tmp:
         data = materialize(Path(tmp)) / "depth_real"
-        skel = sorted((data / "skeltrack" / "tests" / "resources").glob("depth-data-*"))
-        a = picture([np.fromfile(f, "<u2").reshape(480, 640) for f in skel[:6]])
+        skel = sorted((data / "skeltrack" / "tests" / "resources").glob("depth-data-*"))[:6]
+        # Skeltrack's frames are named by their device timestamps: 3-5 frames of a recording apart, so tracked
+        # at 30 frames/s their arms would seem to move 3-5 times as fast as they did (and be held: step 13)
+        ticks = [int(f.name.split("-")[-1].split(".")[0]) for f in skel]
+        a = picture([np.fromfile(f, "<u2").reshape(480, 640) for f in skel],
+                    [ticks_between(ticks[0], t) / TIMESTAMP_HZ for t in ticks])
         cal = Calibration()
         b = picture([cal.to_mm(r) for r in load_fakenect_dir(data / "fakenect_openiss" / "fakenect-record")])
     write_png(args.out, np.concatenate([a, b], axis=1))
