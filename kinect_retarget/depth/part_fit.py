@@ -50,6 +50,7 @@ ARM_REACH = True            # an arm joint the fit doubts may move farther, with
 SDK_HAND = 0.037
 SDK_ANKLE_ABOVE_FOOT, SDK_ANKLE_BEHIND_FOOT = 0.041, 0.041
 WRIST_BEFORE_HAND = SDK_HAND   # the wrist of a proposed hand sits this far before it (fraction of height)
+ELBOW_TO_HAND = bm.FOREARM + WRIST_BEFORE_HAND   # the elbow to the hand joint, the forearm being rigid
 # without a floor, the ankle where the SDK puts it relative to the proposed foot (else moved with the foot):
 # on the real benchmark's subjects 1-2 ankles 9.5 -> 7.5 cm but the shins' directions 1.6 degrees worse; off
 ANKLE_FROM_FOOT = False
@@ -180,7 +181,7 @@ def _arm_direct(pos, st, p, conf, use, s, height) -> None:
         pos[el], st[el] = p[el], _state(conf[el])
     if use[ha]:
         pos[ha], st[ha] = p[ha], _state(conf[ha])
-        reach = (bm.FOREARM + WRIST_BEFORE_HAND) * height   # elbow to hand joint, the forearm being rigid
+        reach = ELBOW_TO_HAND * height
         # a hand part seen only up the forearm, from an elbow where an elbow can be (from one by the shoulder
         # the forearm's direction is unknown: real frames nearer than any training image put hands off the body)
         if (np.linalg.norm(pos[ha] - pos[el]) < FOREARM_MIN * reach
