@@ -156,6 +156,7 @@ class SkeletonTracker:
         if self._last_seen is None or not np.isfinite(ts) or ts - self._last_seen > LOST_RESET_S:
             self._prev = self._prev_states = self._lateral = self._person_centroid = self.last_good = None
             self.confidence.reset()
+            self.arm_gate.reset()   # its history is the forgotten person's too
 
     def _choose(self, people: list[PersonMask], ts: float) -> PersonMask | None:
         """The tracked person by continuity; a new one is the largest person-like, most central region."""

@@ -79,3 +79,16 @@ def test_a_jump_back_or_a_tracked_or_slow_hand_is_taken():
     np.testing.assert_allclose(back[6:], np.repeat(rest[None], 3, axis=0))   # back where it was: taken
     slow = [rest + [0.03 * k, 0.0, 0.0] for k in range(10)]   # 3 cm a frame
     np.testing.assert_allclose(_run_gate(slow), np.array(slow))
+
+
+def test_a_tracker_that_forgets_its_performer_forgets_the_gates_history():
+    """With no person in view and no usable timestamp the tracker forgets the pose at once; its arm gate must
+    too, or the next performer's first frames are held to the last one's arms."""
+    from kinect_retarget.depth.skeleton_tracker import SkeletonTracker, TrackerSettings
+    tracker = SkeletonTracker(settings=TrackerSettings(part_forest=None))
+    for i in range(6):
+        tracker.arm_gate.apply(*standing(), i / 30.0)
+    tracker.update(np.zeros((480, 640), np.uint16), float("nan"))   # nobody there
+    p, st = standing()
+    p[J("HandLeft")] = p[J("HandRight")] + [0.0, 0.3, -0.2]   # 60 cm from the last performer's hand
+    assert not tracker.arm_gate.apply(p, st, 6 / 30.0).any()
