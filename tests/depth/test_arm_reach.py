@@ -47,13 +47,15 @@ def test_hands_within_reach_or_tracked_are_left_alone():
     np.testing.assert_array_equal(p, before)
 
 
-def _run_gate(hand_left_path, tracked_at=()):
+def _run_gate(hand_left_path, tracked_at=(), elbow_tracked=False, elbow_shift=(0.0, 0.0, 0.0)):
     """Feed a standing performer whose left hand follows `hand_left_path` (one point a 30 Hz frame)."""
     gate = ArmSpeedGate()
     out = []
     for i, hand in enumerate(hand_left_path):
         p, st = standing()
         p[J("HandLeft")] = hand
+        p[J("ElbowLeft")] += np.multiply(i, elbow_shift)
+        st[J("ElbowLeft")] = TRACKED if elbow_tracked else st[J("ElbowLeft")]
         if i in tracked_at:
             st[J("HandLeft")] = TRACKED
         gate.apply(p, st, i / 30.0)
@@ -69,6 +71,17 @@ def test_a_hand_jumping_onto_another_part_is_held_for_a_few_frames_only():
     np.testing.assert_allclose(out[10:], np.repeat(away[None], 5, axis=0))    # ... then what is seen is taken
     early = _run_gate([rest] * 2 + [away] * 3)   # the first frames of a fit settle: nothing held
     np.testing.assert_allclose(early[2:], np.repeat(away[None], 3, axis=0))
+
+
+def test_a_hand_jumping_below_a_tracked_elbow_is_held_to_the_elbow():
+    p, _ = standing()
+    rest, away = p[J("HandLeft")], p[J("HandLeft")] + [0.1, -0.45, 0.05]   # an arm curl's hand taken by the hip
+    shift = np.array([0.01, 0.0, 0.0])   # the tracked elbow drifts 1 cm a frame: the held hand goes with it
+    out = _run_gate([rest] * 5 + [away] * 10, elbow_tracked=True, elbow_shift=shift)
+    np.testing.assert_allclose(out[5:10], rest + np.arange(1, 6)[:, None] * shift)   # held 5 frames, with the elbow
+    np.testing.assert_allclose(out[10:], np.repeat(away[None], 5, axis=0))           # ... then what is seen
+    seen = _run_gate([rest] * 5 + [away] * 3, tracked_at={5, 6, 7}, elbow_tracked=True)   # the hand tracked: taken
+    np.testing.assert_allclose(seen[5:], np.repeat(away[None], 3, axis=0))
 
 
 def test_a_jump_back_or_a_tracked_or_slow_hand_is_taken():
