@@ -21,7 +21,7 @@ from .arm_reach import ArmSpeedGate, fold_overreaching_hands
 from .body_model_fit import BodyCalibration
 from .depth_camera import DepthCamera
 from .confidence import ConfidenceCheck
-from .part_fit import apply_proposals, body_frame, disagreeing, ends_seen, seen_on_parts
+from .part_fit import USE_CONFIDENCE, apply_proposals, body_frame, disagreeing, ends_seen, seen_on_parts
 from .part_forest import MODEL_PATH, load_forest
 from .part_proposals import propose
 from .sdk_joints import to_sdk_joints
@@ -32,6 +32,7 @@ LOST_RESET_S = 0.5   # forget the previous pose after this long without the pers
 CALIBRATION_FRAMES = 15    # with a floor: standing measurements blended into the height
 CALIBRATION_MEMORY = 300   # standing measurements kept for the height
 STANDING_PATCH = 0.53      # torso patch above the feet, fraction of the height, below which one is not standing
+HEAD_PART_NEAR = 0.25      # m: a head extremity farther than this from a confident head part is a raised hand
 
 
 @dataclass
@@ -173,12 +174,18 @@ class SkeletonTracker:
         """Measure standing height where the head and both feet are seen, both feet down. With no floor in view
         (pre-segmented frames, a sensor that does not see the floor) heights are taken above the person's
         lowest point; every pose but standing upright is shorter (seated, crouched, bowing, sitting down), and
-        the lowest point is less sure than a floor, so the height is a high percentile of all measurements."""
+        the lowest point is less sure than a floor, so the height is a high percentile of all measurements. A
+        head extremity far from a confident head part is hands held over the head, not a height."""
         if self.floor is not None and self.calibration.frames >= CALIBRATION_FRAMES:
             return   # the floor's own height is sure: the first frames standing on it are enough
         labels = {k: p for k, p in fit.extrema}
         if not {"head", "FootLeft", "FootRight"} <= set(labels):
             return
+        props = self.last_proposals if self.forest is not None else None
+        head = KINECT_V1.index("Head")
+        if (props is not None and props.confidence[head] >= USE_CONFIDENCE
+                and np.linalg.norm(labels["head"] - props.positions[head]) > HEAD_PART_NEAR):
+            return   # hands held over the head (a basketball shot) measured as the head: 1.81 m for 1.69
         pts = self.last_grid.xyz[person.mask]
         if self.floor is not None:
             height = self.floor.height

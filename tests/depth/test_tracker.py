@@ -117,3 +117,39 @@ def test_pre_segmented_frames_without_floor_or_gravity(rendered):
     assert 1.5 < tracker.calibration.height < 1.8, tracker.calibration.height
     err = np.linalg.norm(pos - to_sdk_joints(seq.joints), axis=-1)
     assert err.mean() < 0.08, err.mean()
+
+
+def test_a_head_extremity_away_from_the_head_part_is_not_measured(rendered, monkeypatch):
+    """Hands held over the head (a basketball shot) give the fit's head extremity to the hands: where the
+    forest's confident head part lies elsewhere, the frame is not a standing-height measurement."""
+    from dataclasses import replace
+
+    from kinect_retarget.core.conventions import depth_pixel_to_kinect
+    from kinect_retarget.core.skeletons import KINECT_V1
+    from kinect_retarget.depth import skeleton_tracker
+    seq, _ = rendered
+    cam = SkeletonTracker().camera
+    v, u = np.mgrid[0:480, 0:640]
+    mm = seq.mm.copy()
+    for f in mm:   # pre-segmented (no floor): the height comes from the tracker's own measurements
+        xyz = depth_pixel_to_kinect(u, v, f * 0.001, cam.f, cam.cx, cam.cy)
+        f[((xyz @ -seq.gravity) < -0.88) | (xyz[..., 2] > 4.4)] = 0
+
+    def heights(shift):
+        real = skeleton_tracker.propose
+
+        def moved_head(*args):
+            props = real(*args)
+            pos, conf = props.positions.copy(), props.confidence.copy()
+            pos[KINECT_V1.index("Head")] += shift
+            conf[KINECT_V1.index("Head")] = 1.0   # as sure as a head gets
+            return replace(props, positions=pos, confidence=conf)
+
+        monkeypatch.setattr(skeleton_tracker, "propose", moved_head)
+        tracker = SkeletonTracker()
+        for f, t in zip(mm, seq.times):
+            tracker.update(f, t)
+        return tracker.calibration.frames
+
+    assert heights([0.0, 0.0, 0.0]) > 0
+    assert heights([0.0, -0.4, 0.0]) == 0   # the head part 40 cm below the extremity: not measured
