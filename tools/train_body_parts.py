@@ -2,7 +2,7 @@
 
     .venv/bin/python tools/train_body_parts.py [--images 6000] [--pixels 400] [--trees 3] [--depth 20]
                                                [--seed 0] [--jobs 2] [--balance 1.0] [--no-skirts] [--out PATH]
-                                               [--cache DIR]
+                                               [--cache DIR] [--reach-images N]
     .venv/bin/python tools/train_body_parts.py --evaluate FOREST.npz [FOREST.npz ...] [--images 300] [--seed 99]
                                                [--plain]
 
@@ -24,6 +24,10 @@ arrays (part_forest.PartForest). Small parts (hands, wrists, ankles: 0.4 % of th
 chest) would hardly shape the splits, so each sample is weighted by its part's frequency to the power
 -`--balance` while the trees grow (1.0: every part weighs the same); the leaves' part probabilities are then
 counted again without weights, so they stay the plain frequencies the proposals' thresholds expect.
+
+`--reach-images N` adds N further images (numbered from REACH_FIRST, so the others' draws and cache are
+unchanged) whose arms reach to places on and around the body instead of swinging at random
+(sim/reach_poses.py: crossed arms, hands at a shoulder, the face, the belly, the hips, in front and overhead).
 
 Seeded: image i and performer g draw from their own generators (seed, i) and (seed, g), so the same
 arguments give the same data (and trees) whatever --jobs is; --cache DIR keeps 50-image chunks and resumes.
@@ -57,6 +61,7 @@ from kinect_retarget.sim.bvh_motion import read_bvh_positions  # noqa: E402
 from kinect_retarget.sim.depth_render import _tilt, kinect_artifacts, quad_sampler, surface_points  # noqa: E402
 from kinect_retarget.sim.makehuman_body import DRIVER_NAMES, load_body  # noqa: E402
 from kinect_retarget.sim.mocap_pose import _rest_points, cmu_points, pose_from_points  # noqa: E402
+from kinect_retarget.sim.reach_poses import reaching  # noqa: E402
 from kinect_retarget.takes import load_take  # noqa: E402
 
 CLIPS = ("01_01", "131_01", "131_02", "131_03")
@@ -70,6 +75,7 @@ MAX_OFFSET = 0.6    # metres
 PER_BODY = 10       # images per performer
 CHUNK = 50          # images per cache file
 TAKE_SHARE = 0.5    # share of images posed from the Kinect recordings (the rest from CMU)
+REACH_FIRST = 1_000_000   # images numbered from here have their arms reaching on and around the body
 
 
 def _unit(v):
@@ -214,8 +220,8 @@ def person_grids(first: int, count: int):
         if not _W["plain"] and rng.random() < 0.5:
             pose = mirrored(pose)
         b, groups, vl, scale = body
-        mm, labels = render_one(b, vl, groups, swing_limbs(pose, rng, 0.35 if use_takes else 0.7), rng, cam,
-                                scale)
+        pose = reaching(pose, rng) if i >= REACH_FIRST else swing_limbs(pose, rng, 0.35 if use_takes else 0.7)
+        mm, labels = render_one(b, vl, groups, pose, rng, cam, scale)
         grid = DepthGrid.from_mm(mm, cam, STEP)
         glab = labels[STEP // 2::STEP, STEP // 2::STEP]
         person = grid.valid & (glab != BACKGROUND)
@@ -261,10 +267,16 @@ def make_data(args):
     if args.cache:
         Path(args.cache).mkdir(parents=True, exist_ok=True)
     tasks = [(f, min(CHUNK, args.images - f), args.pixels, offsets, args.cache) for f in range(0, args.images, CHUNK)]
+    tasks += [(f, min(CHUNK, REACH_FIRST + args.reach_images - f), args.pixels, offsets, args.cache)
+              for f in range(REACH_FIRST, REACH_FIRST + args.reach_images, CHUNK)]
     _setup(args.seed, False)
     # the images of performers who wear a skirt or coat hem are left out chunk by chunk (memory: the samples
     # of 24,000 images are 11 GB)
     skirted = skirted_performers(args.seed, args.images // PER_BODY + 1) if args.no_skirts else None
+    if skirted is not None and args.reach_images:   # the reaching images' performers follow on
+        skirted = np.concatenate([skirted, np.zeros(REACH_FIRST // PER_BODY - len(skirted), bool),
+                                  [_skirt_drawn(np.random.default_rng([args.seed, 2, REACH_FIRST // PER_BODY + g]))
+                                   for g in range(args.reach_images // PER_BODY + 1)]])
     pool = _pool(args.jobs)
     xs, ys, left_out, t0 = [], [], 0, time.perf_counter()
     for k, (x, y, image) in enumerate(pool.imap(_chunk_samples, tasks) if pool else map(_chunk_samples, tasks)):
@@ -275,8 +287,8 @@ def make_data(args):
         xs.append(x)
         ys.append(y)
         if (k + 1) % 20 == 0 or k + 1 == len(tasks):
-            print(f"  {min((k + 1) * CHUNK, args.images)}/{args.images} images, {time.perf_counter() - t0:.0f} s",
-                  flush=True)
+            total = args.images + args.reach_images
+            print(f"  {min((k + 1) * CHUNK, total)}/{total} images, {time.perf_counter() - t0:.0f} s", flush=True)
     if pool:
         pool.close()
     if skirted is not None:
@@ -381,6 +393,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--images", type=int, default=6000)
     ap.add_argument("--pixels", type=int, default=400, help="person cells sampled per image")
+    ap.add_argument("--reach-images", type=int, default=0,
+                    help="further images whose arms reach on and around the body (sim/reach_poses.py)")
     ap.add_argument("--trees", type=int, default=3)
     ap.add_argument("--depth", type=int, default=20)
     ap.add_argument("--seed", type=int, default=0)
@@ -401,7 +415,7 @@ def main() -> None:
     t0 = time.perf_counter()
     x, y, offsets = make_data(args)
     t1 = time.perf_counter()
-    print(f"{len(y)} samples from {args.images} images ({t1 - t0:.0f} s)", flush=True)
+    print(f"{len(y)} samples from {args.images} + {args.reach_images} images ({t1 - t0:.0f} s)", flush=True)
     if args.data_only:
         return
     from sklearn.ensemble import RandomForestClassifier
@@ -414,7 +428,8 @@ def main() -> None:
     recount_leaves(rf, x, y)
     forest = flatten(rf, offsets)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    forest.save(args.out, images=args.images, pixels=args.pixels, trees=args.trees, depth=args.depth,
+    forest.save(args.out, images=args.images, reach_images=args.reach_images, pixels=args.pixels, trees=args.trees,
+                depth=args.depth,
                 seed=args.seed, balance=args.balance, no_skirts=args.no_skirts, samples=int(len(y)), data_s=round(t1 - t0), train_s=round(time.perf_counter() - t1))
     print(f"wrote {args.out}: {len(forest.feature)} nodes, depth {forest.depth} "
           f"({Path(args.out).stat().st_size / 1e6:.1f} MB); training took {time.perf_counter() - t1:.0f} s")
