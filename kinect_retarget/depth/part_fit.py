@@ -73,7 +73,7 @@ SEEN = np.array([n.startswith(("Head", "Shoulder", "Elbow", "Hand", "Knee")) for
 # ... those taken as proposed (DIRECT) however far the fit had them: on real depth, shoulders the fit tracked
 # 10-25 cm from their confident parts, moved onto them, lay 4-6 cm from the SDK's
 SEEN_ANY_MOVE = np.isin(np.arange(len(KINECT_V1.joints)), [J(n) for n in DIRECT])
-HANDS = [J(f"Hand{s}") for s in SIDES]
+HAND_JOINTS = [J(f"Hand{s}") for s in SIDES]
 # joints whose proposals check the fit's states (not hips, knees or spine: the fit's states stand for those)
 CHECKED = np.array([not n.startswith(("Hip", "Knee", "Spine")) for n in KINECT_V1.joints])
 OUTWARD = np.array([1.0 if "Left" in n else -1.0 if "Right" in n else 0.0 for n in KINECT_V1.joints])
@@ -300,7 +300,7 @@ def seen_on_parts(before: np.ndarray, pos: np.ndarray, props, frame: np.ndarray 
         within[before_states == TRACKED] = AGREE
     within[SEEN_ANY_MOVE] = MAX_MOVE
     on_part = off_part < 1e-6
-    on_part[HANDS] = off_part[HANDS] < HAND_ON_PART
+    on_part[HAND_JOINTS] = off_part[HAND_JOINTS] < HAND_ON_PART
     seen = SEEN & on_part & (moved > 0) & (moved <= within) & confident
     for s in SIDES:
         wr = J(f"Wrist{s}")
