@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.quat import normalize
+
 TORSO = 0.33   # hips-to-neck length of the CMU skeleton, in metres: the targets below are for this torso
 
 # target -> (centre, lateral range, up range, forward range), metres for TORSO; centres are pose points
@@ -30,7 +32,7 @@ WEIGHTS = np.array([0.22, 0.14, 0.16, 0.14, 0.18, 0.08, 0.08])
 
 
 def _unit(v):
-    return v / max(float(np.linalg.norm(v)), 1e-9)
+    return normalize(v, 1e-9)
 
 
 def body_axes(p: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
