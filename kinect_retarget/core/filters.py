@@ -86,12 +86,15 @@ class DoubleExponentialFilter:
 
 @dataclass
 class OneEuroFilter:
-    """One-Euro filter (Casiez et al. 2012): a low-pass whose cutoff rises with speed, per coordinate."""
+    """One-Euro filter (Casiez et al. 2012): a low-pass whose cutoff rises with speed, per coordinate.
+    `max_deviation` (metres) bounds how far a joint may trail its raw position, as the Kinect SDK's own filter
+    bounds its output: no lag beyond it, however fast the move."""
 
     min_cutoff: float = 1.0   # Hz
     beta: float = 2.0         # cutoff increase per m/s
     d_cutoff: float = 1.0     # Hz, for the speed estimate
     rate: float = 30.0        # used for the first step only
+    max_deviation: float = math.inf
 
     def __post_init__(self) -> None:
         self.reset()
@@ -133,6 +136,8 @@ class OneEuroFilter:
         gain += self.min_cutoff * 2 * math.pi * dt
         gain = gain / (gain + 1.0)
         diff *= gain
+        if math.isfinite(self.max_deviation):
+            diff = self._bounded(x, self._x + diff) - self._x
         if all_valid:  # the common case skips the bookkeeping below; same numbers
             self._x = self._x + diff
             self._dx = dx_hat
@@ -146,6 +151,12 @@ class OneEuroFilter:
         self._dx = np.where(valid & ~restart, dx_hat, 0.0)
         self._seen = valid
 
+    def _bounded(self, raw: np.ndarray, filtered: np.ndarray) -> np.ndarray:
+        """`filtered` moved toward `raw` where a joint (a row) trails it by more than max_deviation."""
+        lag = filtered - raw
+        dist = np.sqrt(np.sum(lag * lag, axis=-1, keepdims=True))
+        return raw + lag * np.minimum(1.0, self.max_deviation / np.maximum(dist, 1e-12))
+
     def run(self, positions: np.ndarray, states: np.ndarray, times: np.ndarray | None = None) -> np.ndarray:
         positions = np.asarray(positions, dtype=np.float64)
         out = np.empty_like(positions)
@@ -157,7 +168,7 @@ class OneEuroFilter:
         if self._x is None:
             out[0] = self.step(positions[0], states[0], None if times is None else float(times[0]))
             start = 1
-        if all_valid[start:].all() and self._seen.all():
+        if all_valid[start:].all() and self._seen.all() and not math.isfinite(self.max_deviation):
             return self._run_all_tracked(positions, out, start, times)
         for i in range(start, out.shape[0]):
             dt = self._next_dt(None if times is None else float(times[i]))

@@ -43,3 +43,18 @@ def test_lag_measure_detects_a_known_delay(rng):
     raw = np.sin(t / 10.0)[:, None, None] * np.ones((1, 2, 3)) + rng.normal(0, 1e-3, (300, 2, 3))
     delayed = np.concatenate([raw[:2], raw[:-2]])
     assert lag_frames(raw, delayed) == pytest.approx(2.0, abs=0.1)
+
+
+def test_a_bounded_one_euro_never_trails_by_more_than_its_bound(data_dir):
+    take = load_take(data_dir / "kinect_v2" / "Ges03_drawlines.csv")
+    moved = take.positions.copy()
+    moved[60:] += [0.5, 0.0, 0.0]   # the whole body half a metre aside at once
+    free = OneEuroFilter(min_cutoff=1.0, beta=1.5).run(moved, take.states, take.times)
+    bounded = OneEuroFilter(min_cutoff=1.0, beta=1.5, max_deviation=0.03).run(moved, take.states, take.times)
+    trail = lambda out: np.linalg.norm(out - moved, axis=-1)
+    assert trail(free)[60].max() > 0.2                    # the unbounded filter is left far behind
+    assert trail(bounded).max() <= 0.03 + 1e-12
+    assert jitter(bounded[:60]) < 0.7 * jitter(take.positions[:60])   # and still steadies small moves
+    f = OneEuroFilter(min_cutoff=1.0, beta=1.5, max_deviation=0.03)   # live == bake with a bound too
+    live = np.array([f.step(moved[i], take.states[i], take.times[i]) for i in range(take.frame_count)])
+    np.testing.assert_array_equal(bounded, live)
