@@ -1,6 +1,7 @@
 """Depth -> skeleton tracking: accuracy on rendered real motions, speed, latency and robustness.
 
     .venv/bin/python benchmarks/bench_depth_tracking.py [--only walk,hop,speed,...] [--save DIR] [--forest PATH|none]
+                                                        [--raw-output]
 
 Renders CMU mocap (walks 131_02 and 131_01, hop 131_03, forward jumps 01_01) on the MakeHuman body as Kinect v1 depth
 (cached in $KR_DEPTH_CACHE, default /tmp/kinect_retarget_depth_cache), tracks it, prints the figures.
@@ -98,11 +99,14 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--only", help="comma-separated motion/scenario names to run")
     ap.add_argument("--save", help="directory to write each motion's tracked positions/states (.npz)")
+    ap.add_argument("--raw-output", action="store_true", help="score the tracker's joints before its output "
+                    "smoothing (TrackerSettings.steady_output = False)")
     ap.add_argument("--forest", help="body-part forest (.npz) to track with instead of the shipped one; 'none': "
                     "track without body parts")
     args = ap.parse_args()
     if args.forest:
         SETTINGS.part_forest = None if args.forest == "none" else args.forest
+    SETTINGS.steady_output = not args.raw_output
     only = set(args.only.split(",")) if args.only else None
     print("depth tracking benchmark (640x480 input, one thread; errors in cm)")
     all_lat, errs, frontal_errs, named = [], [], [], {}

@@ -1,7 +1,7 @@
 """Depth -> skeleton tracking on real Kinect v1 depth, measured against the Kinect SDK's own skeleton.
 
     .venv/bin/python benchmarks/bench_real_depth.py [--subjects 1,2] [--trials 1] [--actions 1,5] [--limit N]
-                                                    [--save DIR] [--load DIR]
+                                                    [--save DIR] [--load DIR] [--raw-output]
 
 Reads ../shared/data/utd_mhad_dev/ in place (UTD-MHAD, research use only: nothing from it, or computed from
 it, goes into the repository; see its README) and skips with a message when the folder is absent. Each
@@ -161,6 +161,8 @@ def main() -> None:
     ap.add_argument("--save", help="directory to write each sequence's tracked positions/states (.npz)")
     ap.add_argument("--forest", help="body-part forest (.npz) to track with instead of the shipped one; 'none': "
                     "track without body parts")
+    ap.add_argument("--raw-output", action="store_true", help="score the tracker's joints before its output "
+                    "smoothing (TrackerSettings.steady_output = False)")
     ap.add_argument("--load", help="score positions/states saved by --save instead of tracking")
     args = ap.parse_args()
     if not DATA.is_dir():
@@ -172,6 +174,7 @@ def main() -> None:
     settings = TrackerSettings()
     if args.forest:
         settings.part_forest = None if args.forest == "none" else args.forest
+    settings.steady_output = not args.raw_output
     rows, lat_all, t0 = [], [], time.perf_counter()
     for a, s, t, path in seqs:
         depth, sdk = load(path)

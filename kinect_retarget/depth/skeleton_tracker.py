@@ -21,6 +21,7 @@ from .arm_reach import ArmSpeedGate, fold_overreaching_hands
 from .body_model_fit import BodyCalibration
 from .depth_camera import DepthCamera
 from .confidence import ConfidenceCheck
+from .output_smoothing import OutputSmoothing
 from .part_fit import USE_CONFIDENCE, apply_proposals, body_frame, disagreeing, ends_seen, seen_on_parts
 from .part_forest import MODEL_PATH, load_forest
 from .part_proposals import propose
@@ -41,6 +42,7 @@ class TrackerSettings:
     smoothing: float = 0.35       # 0 = raw fit; blends toward the previous frame for small moves only
     floor_refit_every: int = 15   # frames between floor fits (the floor does not move)
     part_forest: str | None = MODEL_PATH   # body-part forest (.npz) whose joint proposals refine the fit; None = off
+    steady_output: bool = True    # reported joints about as steady as the SDK's (output_smoothing.py); False = raw
 
 
 class SkeletonTracker:
@@ -71,6 +73,7 @@ class SkeletonTracker:
         self.last_good: FitResult | None = None
         self.last_proposals = None
         self.arm_gate = ArmSpeedGate()
+        self.output_smoothing = OutputSmoothing()
 
     def set_gravity(self, gravity) -> None:
         """Accelerometer reading (any scale), pointing down in camera space."""
@@ -151,6 +154,8 @@ class SkeletonTracker:
         fold_overreaching_hands(out, st, None if self.forest is None else self.last_proposals.positions,
                                 self.calibration.height)
         self.arm_gate.apply(out, st, ts)
+        if self.settings.steady_output:
+            self.output_smoothing.apply(out, st, ts)
         return out, st
 
     def _lose(self, ts: float) -> None:
@@ -158,6 +163,7 @@ class SkeletonTracker:
             self._prev = self._prev_states = self._lateral = self._person_centroid = self.last_good = None
             self.confidence.reset()
             self.arm_gate.reset()   # its history is the forgotten person's too
+            self.output_smoothing.reset()
 
     def _choose(self, people: list[PersonMask], ts: float) -> PersonMask | None:
         """The tracked person by continuity; a new one is the largest person-like, most central region."""
