@@ -36,12 +36,16 @@ def test_only_the_torso_arm_knee_and_ankle_joints_move_and_by_the_stated_amounts
                                (1 - sdk_joints.HIPS_INWARD) * width(mh, "HipLeft", "HipRight"), rtol=0.02)
     assert np.all(width(sdk, "ShoulderLeft", "ShoulderRight") < width(mh, "ShoulderLeft", "ShoulderRight"))
     torso = np.linalg.norm(axis, axis=-1)
-    for s in ("Left", "Right"):   # the forearm and hand moved out along the upper arm, unchanged in shape
+    up = axis / torso[:, None]
+    front = np.cross(mh[:, J("HipLeft")] - mh[:, J("HipRight")], up)
+    front /= np.linalg.norm(front, axis=-1, keepdims=True)
+    assert np.all(front[:, 2] < 0)   # the rendered performer faces the sensor: the front is toward it
+    for s in ("Left", "Right"):   # the arm moved out along the upper arm and forward, unchanged in shape
         upper = mh[:, J(f"Elbow{s}")] - mh[:, J(f"Shoulder{s}")]
         out = upper / np.linalg.norm(upper, axis=-1, keepdims=True) * (sdk_joints.ARM_OUT * torso)[:, None]
+        out += front * (sdk_joints.ARMS_FORWARD * torso)[:, None]
         for n in ("Elbow", "Wrist", "Hand"):
             np.testing.assert_allclose(sdk[:, J(f"{n}{s}")] - mh[:, J(f"{n}{s}")], out, atol=1e-12)
-        up = axis / torso[:, None]
         rise = np.sum((sdk[:, J(f"Knee{s}")] - mh[:, J(f"Knee{s}")]) * up, axis=-1)
         np.testing.assert_allclose(rise, sdk_joints.KNEES_UP * torso, atol=1e-12)
         facing = np.cross(mh[:, J("HipLeft")] - mh[:, J("HipRight")], up)   # the knee goes back, not forward
