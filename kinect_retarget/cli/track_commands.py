@@ -23,6 +23,8 @@ def add_parsers(subparsers) -> None:
     p.add_argument("--out", required=True, help="take to write (.krtake)")
     p.add_argument("--gravity", metavar="GX,GY,GZ", help="accelerometer vector in camera space (default: level)")
     p.add_argument("--focal", type=float, default=575.0, help="depth focal length in pixels (default 575)")
+    p.add_argument("--raw-joints", action="store_true", help="write the joints before the tracker's own "
+                   "smoothing (steadied like the Kinect SDK's by default; docs/depth_tracking.md, step 14)")
     p.set_defaults(handler=run_track)
 
 
@@ -44,7 +46,7 @@ def load_replay(path: str):
 
 def run_track(args) -> int:
     from ..depth.depth_camera import DepthCamera
-    from ..depth.skeleton_tracker import track_depth_frames
+    from ..depth.skeleton_tracker import TrackerSettings, track_depth_frames
     from ..takes import krtake
     if bool(args.depth) == bool(args.replay):
         raise TakeError("give either a capture .npz or --replay DUMP")
@@ -62,7 +64,8 @@ def run_track(args) -> int:
     def progress(i, n):
         if sys.stderr.isatty() and (i % 30 == 0 or i == n):
             print(f"\rtracking {i}/{n}", end="" if i < n else "\n", file=sys.stderr)
-    take = track_depth_frames(mm, times, DepthCamera(f=args.focal), gravity, progress=progress)
+    settings = TrackerSettings(steady_output=not args.raw_joints)
+    take = track_depth_frames(mm, times, DepthCamera(f=args.focal), gravity, settings, progress=progress)
     krtake.write(args.out, take)
     found = float(np.mean(take.any_tracked))
     print(f"{args.out}: {take.frame_count} frames, skeleton in {found * 100:.0f} % of them, "

@@ -22,6 +22,17 @@ def test_track_capture_writes_a_take(rendered, tmp_path, capsys):
     assert "skeleton in 100 %" in capsys.readouterr().out
 
 
+def test_track_raw_joints_skips_only_the_smoothing(rendered, tmp_path):
+    seq, path = rendered
+    steady, raw = tmp_path / "steady.krtake", tmp_path / "raw.krtake"
+    assert main(["track", str(path), "--out", str(steady)]) == 0
+    assert main(["track", str(path), "--out", str(raw), "--raw-joints"]) == 0
+    a, b = load_take(steady), load_take(raw)
+    np.testing.assert_array_equal(a.states, b.states)
+    trail = np.linalg.norm(a.positions - b.positions, axis=-1)
+    assert 0.0 < trail.max() <= 0.03 + 1e-4   # steadied, never more than 3 cm from the raw joints (float32 takes)
+
+
 def test_track_raw_only_capture_with_device_ticks(rendered, tmp_path):
     seq, _ = rendered
     path = tmp_path / "raw.npz"
