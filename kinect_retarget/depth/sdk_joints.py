@@ -41,7 +41,7 @@ ANKLES_UP_SHIN = 0.07    # ... and up along the shin (3.5 cm: the shin's directi
 ARMS_FORWARD = 0.03      # elbow, wrist and hand moved this much forward (the SDK's upper arms lean 3 degrees more so)
 SDK_UPPER_ARM = 0.152    # of standing height, Kinect v2 (MakeHuman's bm.UPPER_ARM 0.137)
 TORSO = bm.HEIGHT_SHOULDER_CENTER - bm.HEIGHT_HIP_CENTER   # the torso as a share of standing height
-UPPER_ARM_LONGER = 0.03  # and this much more: the tracker's tracked upper arms were still 2.5-2.9 cm short of the SDK's
+UPPER_ARM_LONGER = 0.03  # and more: the tracker's tracked upper arms were still 2.5-2.9 cm short of the SDK's
 ARM_OUT = (SDK_UPPER_ARM - bm.UPPER_ARM) / TORSO + UPPER_ARM_LONGER   # elbow, wrist and hand moved out along it
 
 
