@@ -22,9 +22,9 @@ import numpy as np
 
 from ..core.filters import OneEuroFilter
 from ..core.skeletons import KINECT_V1
+from . import arm_reach
 
-J = KINECT_V1.index
-ARMS = np.array([J(f"{n}{s}") for s in ("Left", "Right") for n in ("Elbow", "Wrist", "Hand")])
+ARMS = arm_reach.ARMS.ravel()   # elbows, wrists and hands
 BODY = np.setdiff1d(np.arange(len(KINECT_V1.joints)), ARMS)   # torso, head, shoulders, legs
 BODY_CUTOFF = 1.0   # Hz, at rest
 ARM_CUTOFF = 5.0    # Hz: arms move fast, and a 1 Hz arm lags the performer by a frame
