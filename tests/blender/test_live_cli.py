@@ -102,6 +102,7 @@ def test_live_osc_receives_ni_mate_frames_and_skips_garbage(tmp_path):
     finally:
         stop.set()
         t.join()
+    assert proc.stdout.strip(), (proc.returncode, proc.stderr[-2000:])   # a run that printed nothing says why
     stats = json.loads(proc.stdout.strip().splitlines()[-1])
     assert proc.returncode == 0 and stats["error"] is None, proc.stderr[-2000:]
     assert stats["bad_packets"] == 1 and "bad OSC packet" in stats["warning"]
