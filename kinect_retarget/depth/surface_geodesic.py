@@ -4,13 +4,16 @@ Each cell links to its 8 neighbours with the 3D distance between them, or not at
 jumps (an arm in front of the chest stays separate from it). Distances are relaxed with whole-line
 passes: along a 1D chain, d[i] = S[i] + min_{j<=i}(d[j] - S[j]) with S the running edge length, which
 `np.minimum.accumulate` does for every row, column or diagonal at once. A few alternating passes converge
-to the shortest paths; no Python loop visits a cell.
+to the shortest paths; no Python loop visits a cell. The accumulate is numpy's slowest step (a scalar loop,
+about 4 ns a cell), so each direction's lines are packed into one chain of the person's cells only.
 """
 from __future__ import annotations
 
 import numpy as np
 
-CUT = 1e4  # an edge at a depth discontinuity costs this much: unreachable in practice
+CUT = 10.0  # m: an edge at a depth discontinuity costs this much, beyond any path on a person (and small
+            # enough that the running sums over a whole chain keep sub-nanometre precision)
+UNREACHED = 1e9   # a cell no path has reached yet
 INF = np.inf
 
 
@@ -31,10 +34,18 @@ def _lines(h: int, w: int, dr: int, dc: int) -> np.ndarray:
     return out
 
 
+def _relax(v: np.ndarray, cum: np.ndarray) -> None:
+    """One pass each way along the chain `v`, in place: v = min(v, S + running min of (v - S))."""
+    np.minimum(v, cum + np.minimum.accumulate(v - cum), out=v)
+    np.minimum(v, np.minimum.accumulate((v + cum)[::-1])[::-1] - cum, out=v)
+
+
 class SurfaceGraph:
     """The person's surface as a graph on the depth grid: 8-neighbour edges with 3D lengths, cut at depth
-    discontinuities. Each of the 4 line directions (rows, columns, two diagonals) is stored as padded lines
-    with cumulative edge lengths, so one relaxation pass along a direction is a single accumulate."""
+    discontinuities. Each of the 4 line directions (rows, columns, two diagonals) is stored as one chain: the
+    person's cells line after line, with the running edge length, where a cut edge (and the step from one
+    line's end to the next line) costs CUT. One relaxation pass along a direction is then a single
+    accumulate over the person's cells only, not over the bounding box."""
 
     def __init__(self, xyz: np.ndarray, mask: np.ndarray, max_jump: float = 0.06):
         self.xyz = xyz
@@ -52,9 +63,10 @@ class SurfaceGraph:
             a0, b0 = np.where(real, a, 0), np.where(real, b, 0)
             length = np.linalg.norm(flat_xyz[a0] - flat_xyz[b0], axis=-1)
             ok = real & flat_mask[a0] & flat_mask[b0] & (np.abs(flat_xyz[a0, 2] - flat_xyz[b0, 2]) < max_jump)
-            cum = np.concatenate([np.zeros((lines.shape[0], 1)), np.cumsum(np.where(ok, length, CUT), axis=1)], axis=1)
-            # padding points at one spare slot past the grid, which always reads "unreached"
-            self._dirs.append((np.where(lines >= 0, lines, h * w), cum))
+            step = np.full(lines.shape, CUT)
+            step[:, 1:] = np.where(ok, length, CUT)   # the edge from each cell's predecessor in its line
+            on = (lines >= 0) & flat_mask[np.maximum(lines, 0)]
+            self._dirs.append((lines[on], np.cumsum(step[on])))
 
     def distances(self, sources: np.ndarray, init: np.ndarray | None = None, iterations: int = 12) -> np.ndarray:
         """Geodesic distance (h, w) from the source cells (bool mask or (k, 2) row/col); inf off-surface."""
@@ -64,19 +76,16 @@ class SurfaceGraph:
             d[src & self.mask] = 0.0
         elif src.size:
             d[src[:, 0], src[:, 1]] = 0.0
-        n = d.size
-        flat = np.append(np.where(np.isfinite(d), d, 1e9).ravel(), 1e9)
+        flat = np.where(np.isfinite(d), d, UNREACHED).ravel()
         for _ in range(iterations):
             before = flat.copy()
-            for lines, cum in self._dirs:
-                v = flat[lines]
-                v = np.minimum(v, cum + np.minimum.accumulate(v - cum, axis=1))
-                v = np.minimum(v, -cum + np.minimum.accumulate((v + cum)[:, ::-1], axis=1)[:, ::-1])
-                flat[lines] = v
-                flat[n] = 1e9
+            for cells, cum in self._dirs:
+                v = flat[cells]
+                _relax(v, cum)
+                flat[cells] = v
             if np.array_equal(flat, before):
                 break
-        d = flat[:n].reshape(self.mask.shape)
+        d = flat.reshape(self.mask.shape)
         return np.where((d < CUT * 0.5) & self.mask, d, INF)
 
 

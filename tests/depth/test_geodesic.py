@@ -64,3 +64,46 @@ def test_level_set_centroid_is_on_the_medial_axis():
     d = SurfaceGraph(xyz, mask).distances(np.array([[0, 10]]))
     c = level_set_centroid(xyz, d, 0.8, 0.05)
     assert abs(c[0] - 10 * 0.02) < 0.01 and abs(c[1] + 0.8) < 0.03
+
+
+def _dijkstra(xyz, mask, source, max_jump):
+    """Reference shortest paths on the same 8-neighbour graph, one cell at a time."""
+    import heapq
+    h, w = mask.shape
+    d = np.full((h, w), np.inf)
+    d[source] = 0.0
+    heap = [(0.0, source)]
+    while heap:
+        dist, (r, c) = heapq.heappop(heap)
+        if dist > d[r, c]:
+            continue
+        for dr in (-1, 0, 1):
+            for dc in (-1, 0, 1):
+                rr, cc = r + dr, c + dc
+                if (dr or dc) and 0 <= rr < h and 0 <= cc < w and mask[rr, cc] \
+                        and abs(xyz[rr, cc, 2] - xyz[r, c, 2]) < max_jump:
+                    nd = dist + np.linalg.norm(xyz[rr, cc] - xyz[r, c])
+                    if nd < d[rr, cc]:
+                        d[rr, cc] = nd
+                        heapq.heappush(heap, (nd, (rr, cc)))
+    return d
+
+
+def test_distances_match_dijkstra_on_a_ragged_surface():
+    # holes, islands and depth steps: the chains pack only the person's cells, so gaps must still cut
+    rng = np.random.default_rng(7)
+    xyz = _grid(35, 22)
+    xyz[..., 2] += np.cumsum(rng.normal(0.0, 0.012, (35, 22)), axis=1)
+    xyz[10:20, 12:, 2] -= 0.2                             # a forearm in front of the chest
+    mask = rng.random((35, 22)) > 0.15
+    mask[:, 8] = False
+    mask[5, 8] = True                                     # one bridge between the left strip and the rest
+    graph = SurfaceGraph(xyz, mask, max_jump=0.06)
+    for source in ((3, 2), (30, 15), (14, 16)):
+        if not mask[source]:
+            continue
+        ref = _dijkstra(xyz, mask, source, 0.06)
+        d = graph.distances(np.array([source]), iterations=60)
+        assert np.array_equal(np.isfinite(d), np.isfinite(ref)), source
+        fin = np.isfinite(ref)
+        assert np.max(np.abs(d[fin] - ref[fin])) < 1e-9, source
