@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -50,14 +50,35 @@ class PartForest:
     roots: np.ndarray       # (trees,) node index of each tree's root
     depth: int              # deepest leaf
 
+    @cached_property
+    def node_offsets(self) -> np.ndarray:
+        """(nodes, 2, 2) each node's feature offsets (one gather a level instead of two)."""
+        return self.offsets[self.feature]
+
     def classify(self, zb: np.ndarray, rows: np.ndarray, cols: np.ndarray, cells_per_m: float) -> np.ndarray:
-        """(N, parts) float32 part probabilities of the cells (rows, cols), averaged over the trees."""
+        """(N, parts) float32 part probabilities of the cells (rows, cols), averaged over the trees.
+        The same features as `probe_features`, read from the grid framed by one BACKGROUND_DEPTH cell so
+        that a probe off the grid needs only a clip."""
         t = len(self.roots)
-        node = np.repeat(self.roots[None], len(rows), axis=0).ravel()   # (N * trees,)
-        rr, cc = np.repeat(rows, t), np.repeat(cols, t)
+        h, w = zb.shape
+        framed = np.full((h + 2, w + 2), BACKGROUND_DEPTH)
+        framed[1:-1, 1:-1] = zb
+        framed = framed.ravel()
+        node = np.tile(self.roots, len(rows))   # (N * trees,): each cell's trees side by side
+        rr, cc = np.repeat(rows, t) + 1, np.repeat(cols, t) + 1
+        scale = cells_per_m / zb[rr - 1, cc - 1]
         for _ in range(self.depth):
-            f = probe_features(zb, rr, cc, self.offsets[self.feature[node]], cells_per_m)
-            node = np.where(f <= self.threshold[node], self.left[node], self.right[node])
+            off = self.node_offsets[node]
+            probe = []
+            for k in (0, 1):
+                r = rr + np.rint(off[:, k, 1] * scale).astype(np.int64)
+                c = cc + np.rint(off[:, k, 0] * scale).astype(np.int64)
+                np.clip(r, 0, h + 1, out=r)
+                np.clip(c, 0, w + 1, out=c)
+                r *= w + 2
+                r += c
+                probe.append(framed[r])
+            node = np.where(probe[0] - probe[1] <= self.threshold[node], self.left[node], self.right[node])
         probs = self.leaf_probs[node].reshape(len(rows), t, -1).astype(np.float32)
         return probs.mean(axis=1) * (1.0 / 255.0)
 

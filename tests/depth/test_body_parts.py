@@ -61,3 +61,29 @@ def test_part_labels_from_skin_weights(data_dir):
     assert np.array_equal(seen, np.isfinite(depth))
     cols = np.nonzero(image == PART["hand_left"])[1]
     assert len(cols) > 20 and np.all(cols > cam.cx)   # facing the sensor, the left hand is on the image's right
+
+
+def test_forest_classifies_as_a_node_by_node_walk_with_probe_features(rendered):
+    # the fast path reads probes from a framed grid; the reference follows each cell down each tree
+    from kinect_retarget.depth.part_forest import probe_features
+    forest = load_forest(MODEL_PATH)
+    seq, _ = rendered
+    tracker = SkeletonTracker(gravity=seq.gravity, settings=TrackerSettings(part_forest=None))
+    tracker.update(seq.mm[0], seq.times[0])
+    grid, mask = tracker.last_grid, tracker.last_mask
+    zb = np.where(mask, grid.z, 10.0)
+    zb[:, :3] = 0.8                                       # near probes at the image's edge too
+    rows, cols = np.nonzero(mask)
+    pick = np.random.default_rng(3).choice(len(rows), 60, replace=False)
+    rows, cols = np.r_[rows[pick], 0, grid.z.shape[0] - 1], np.r_[cols[pick], 1, grid.z.shape[1] - 2]
+    cells_per_m = grid.camera.f / grid.step
+    probs = forest.classify(zb, rows, cols, cells_per_m)
+    for i in range(len(rows)):
+        expect = np.zeros(len(PARTS))
+        for node in forest.roots:
+            while forest.left[node] != node:
+                f = probe_features(zb, rows[i:i + 1], cols[i:i + 1], forest.offsets[forest.feature[node]][None],
+                                   cells_per_m)[0]
+                node = forest.left[node] if f <= forest.threshold[node] else forest.right[node]
+            expect += forest.leaf_probs[node] / 255.0
+        assert np.allclose(probs[i], expect / len(forest.roots), atol=1e-6), i
