@@ -18,6 +18,7 @@ import numpy as np
 from ..core.skeletons import INFERRED, KINECT_V1, TRACKED
 from ..core.take import Take
 from .arm_reach import ArmSpeedGate, fold_overreaching_hands
+from .arm_search import hands_at_tracked_wrists
 from .body_model_fit import BodyCalibration
 from .depth_camera import DepthCamera
 from .confidence import ConfidenceCheck
@@ -33,6 +34,7 @@ LOST_RESET_S = 0.5   # forget the previous pose after this long without the pers
 CALIBRATION_FRAMES = 15    # with a floor: standing measurements blended into the height
 CALIBRATION_MEMORY = 300   # standing measurements kept for the height
 STANDING_PATCH = 0.53      # torso patch above the feet, fraction of the height, below which one is not standing
+HANDS_AT_TRACKED_WRISTS = True   # a hand off a tracked elbow and wrist, on the surface seen there, is tracked
 HEAD_PART_NEAR = 0.25      # m: a head extremity farther than this from a confident head part is a raised hand
 
 
@@ -136,6 +138,8 @@ class SkeletonTracker:
             ends, frame = frozenset(), None
         report = fit.states.copy()   # what is reported; the fit's history keeps its own states
         report[seen] = TRACKED
+        if HANDS_AT_TRACKED_WRISTS:
+            report[hands_at_tracked_wrists(fit.positions, report, fit.projector)] = TRACKED
         pos, st = fit.positions, self.confidence.assess(fit.positions, report, fit, own, ends, seen)
         if self.forest is not None:   # reported states only (the fit's history keeps its own)
             doubt |= disagreeing(pos, self.last_proposals, frame)

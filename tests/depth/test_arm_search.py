@@ -136,3 +136,40 @@ def test_well_explained_arms_of_a_performer_facing_the_sensor_are_tracked(data_d
     assert len(promoted) >= 8 and max(promoted) < 0.15
     monkeypatch.setattr(arm_search, "SEARCH_TRACKED_COST", -np.inf)   # the rule off: searched arms inferred
     assert len(tracked_arm_errors()) < len(promoted)
+
+
+def test_hands_at_tracked_wrists_need_the_elbow_the_wrist_and_the_surface():
+    J = {n: i for i, n in enumerate(KINECT_V1.joints)}
+
+    class Surface:   # the hand is on the surface when its x is positive
+        def supported(self, p, inside):
+            return bool(p[0] > 0)
+
+    pos = np.zeros((20, 3))
+    pos[J["HandLeft"]], pos[J["HandRight"]] = [0.3, 0.0, 2.0], [-0.3, 0.0, 2.0]
+    st = np.full(20, TRACKED, np.uint8)
+    st[[J["HandLeft"], J["HandRight"]]] = 1
+    assert np.flatnonzero(arm_search.hands_at_tracked_wrists(pos, st, Surface())).tolist() == [J["HandLeft"]]
+    st[J["WristLeft"]] = 1
+    assert not arm_search.hands_at_tracked_wrists(pos, st, Surface()).any()
+    pos[J["HandRight"], 0] = 0.3   # now seen, but its elbow is only inferred
+    st[J["ElbowRight"]] = 1
+    assert not arm_search.hands_at_tracked_wrists(pos, st, Surface()).any()
+
+
+def test_hanging_hands_below_tracked_wrists_are_tracked(data_dir, monkeypatch):
+    """The same walk: hands that hang off tracked wrists are reported tracked, and they are right."""
+    from kinect_retarget.depth import skeleton_tracker
+    from kinect_retarget.sim.synthetic_depth import Scenario, render_sequence
+    seq = render_sequence(str(data_dir / "mocap_bvh" / "131_02.bvh"), str(data_dir / "meshes" / "makehuman"),
+                          Scenario(seed=5), start=0, frames=16)
+    hands = [KINECT_V1.index("HandLeft"), KINECT_V1.index("HandRight")]
+
+    def tracked_hand_errors():
+        return [float(np.linalg.norm(pos[j] - g[j])) for (pos, st), g in zip(_track(seq), seq.joints)
+                for j in hands if st[j] == TRACKED]
+
+    with_rule = tracked_hand_errors()
+    monkeypatch.setattr(skeleton_tracker, "HANDS_AT_TRACKED_WRISTS", False)
+    without = tracked_hand_errors()
+    assert len(with_rule) >= len(without) + 8 and max(with_rule) < 0.10
