@@ -10,13 +10,14 @@ farther out along it), its knees a little higher and farther back (its thighs le
 forward than the tracker's), its ankles higher up the shin and a little farther back (the tracker's lay 4 cm
 lower and 1-2 cm farther forward, median, and its shins leaned about 3 degrees farther forward), and its arms
 a little farther forward (its upper arms lean about 3 degrees more forward than the tracker's, in all four
-subject-trial groups).
+subject-trial groups), and its whole arm, shoulder to hand, a little nearer the midline and lower; its hip joints and feet lie a
+little farther forward.
 Output in the SDK's convention means a depth-tracked take is read, retargeted and compared like one the SDK
 recorded.
 
 The amounts are fractions of the torso (the hips' midpoint to ShoulderCenter), so the same function converts
 the tracker's output and a rendered body's true joints alike (the synthetic benchmark scores against those).
-The hips' width and the upper arm come from the Kinect v2 recordings; the other eleven numbers (no
+The hips' width and the upper arm come from the Kinect v2 recordings; the other fifteen numbers (no
 redistributable Kinect v1 skeleton shows them) are settings chosen on the real-depth benchmark's subjects 1-2,
 trial 1, as its other settings were, and they hold on subjects 3-4, not tuned on (docs/depth_tracking.md).
 """
@@ -32,6 +33,8 @@ HIP_CENTER_UP = 0.20     # HipCenter above the hip joints' midpoint, along the t
 SPINE_UP = 0.14          # Spine above HipCenter
 HIPS_INWARD = 0.25       # hip joints moved this share of the way toward the midline (1 - 0.099 / 0.132)
 HIPS_UP = 0.06
+HIPS_FORWARD = 0.03      # hip joints moved this much forward (the tracker's lay 1.4-1.8 cm behind the SDK's) ...
+FEET_FORWARD = 0.04      # ... and the feet (2.1-3.6 cm behind)
 SHOULDERS_INWARD = 0.05  # shoulders moved this share of the way toward ShoulderCenter
 SHOULDERS_UP = -0.06
 KNEES_BACK = 0.05        # knees moved this much back (the SDK's thighs lean 6 degrees less forward) ...
@@ -43,11 +46,16 @@ SDK_UPPER_ARM = 0.152    # of standing height, Kinect v2 (MakeHuman's bm.UPPER_A
 TORSO = bm.HEIGHT_SHOULDER_CENTER - bm.HEIGHT_HIP_CENTER   # the torso as a share of standing height
 UPPER_ARM_LONGER = 0.03  # and more: the tracker's tracked upper arms were still 2.5-2.9 cm short of the SDK's
 ARM_OUT = (SDK_UPPER_ARM - bm.UPPER_ARM) / TORSO + UPPER_ARM_LONGER   # elbow, wrist and hand moved out along it
+# the whole arm, shoulder to hand, moved together (its bones keep their directions): the SDK's arm joints lay
+# 1.1-2.3 cm nearer the midline and its shoulders and elbows 1.4-2.5 cm lower than the tracker's (median, on
+# both subject pairs)
+ARM_INWARD = 0.03
+ARM_DOWN = 0.02
 
 
 def to_sdk_joints(positions: np.ndarray) -> np.ndarray:
     """(..., 20, 3) Kinect v1 joints on MakeHuman's convention -> the same body's joints where the SDK puts
-    them (a copy; feet, head, ShoulderCenter unchanged)."""
+    them (a copy; head and ShoulderCenter unchanged)."""
     p = np.array(positions, dtype=np.float64, copy=True)
     hips = (p[..., J("HipLeft"), :] + p[..., J("HipRight"), :]) / 2
     axis = p[..., J("ShoulderCenter"), :] - hips
@@ -69,12 +77,19 @@ def to_sdk_joints(positions: np.ndarray) -> np.ndarray:
         out += ARMS_FORWARD * torso * forward
         for n in ("Elbow", "Wrist", "Hand"):
             p[..., J(f"{n}{s}"), :] += out
+    across = left - np.sum(left * up, axis=-1, keepdims=True) * up
+    across /= np.maximum(np.linalg.norm(across, axis=-1, keepdims=True), 1e-9)   # toward the performer's left
+    for s, outward in (("Left", 1.0), ("Right", -1.0)):
+        for n in ("Shoulder", "Elbow", "Wrist", "Hand"):
+            p[..., J(f"{n}{s}"), :] -= (ARM_INWARD * outward * across + ARM_DOWN * up) * torso
     for s in ("Left", "Right"):
         shin = p[..., J(f"Knee{s}"), :] - p[..., J(f"Ankle{s}"), :]
         shin /= np.maximum(np.linalg.norm(shin, axis=-1, keepdims=True), 1e-9)
         p[..., J(f"Ankle{s}"), :] += (ANKLES_UP_SHIN * shin - ANKLES_BACK * forward) * torso
         p[..., J(f"Knee{s}"), :] += (KNEES_UP * up - KNEES_BACK * forward) * torso
         toward(J(f"Hip{s}"), hips, HIPS_INWARD, HIPS_UP)
+        p[..., J(f"Hip{s}"), :] += HIPS_FORWARD * torso * forward
+        p[..., J(f"Foot{s}"), :] += FEET_FORWARD * torso * forward
         toward(J(f"Shoulder{s}"), p[..., J("ShoulderCenter"), :], SHOULDERS_INWARD, SHOULDERS_UP)
     p[..., J("HipCenter"), :] = hips + HIP_CENTER_UP * step
     p[..., J("Spine"), :] = p[..., J("HipCenter"), :] + SPINE_UP * step

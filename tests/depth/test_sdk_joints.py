@@ -10,7 +10,7 @@ from kinect_retarget.depth.sdk_joints import to_sdk_joints
 J = KINECT_V1.index
 MOVED = [J(n) for n in ("HipCenter", "Spine", "HipLeft", "HipRight", "ShoulderLeft", "ShoulderRight", "ElbowLeft",
                         "ElbowRight", "WristLeft", "WristRight", "HandLeft", "HandRight", "KneeLeft", "KneeRight",
-                        "AnkleLeft", "AnkleRight")]
+                        "AnkleLeft", "AnkleRight", "FootLeft", "FootRight")]
 
 
 def _random_rotation(rng):
@@ -21,7 +21,7 @@ def _random_rotation(rng):
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
-def test_only_the_torso_arm_knee_and_ankle_joints_move_and_by_the_stated_amounts(rendered):
+def test_only_the_torso_arm_and_leg_joints_move_and_by_the_stated_amounts(rendered):
     seq, _ = rendered
     mh = seq.joints[:5]
     sdk = to_sdk_joints(mh)
@@ -40,16 +40,26 @@ def test_only_the_torso_arm_knee_and_ankle_joints_move_and_by_the_stated_amounts
     front = np.cross(mh[:, J("HipLeft")] - mh[:, J("HipRight")], up)
     front /= np.linalg.norm(front, axis=-1, keepdims=True)
     assert np.all(front[:, 2] < 0)   # the rendered performer faces the sensor: the front is toward it
-    for s in ("Left", "Right"):   # the arm moved out along the upper arm and forward, unchanged in shape
+    left = mh[:, J("HipLeft")] - mh[:, J("HipRight")]
+    across = left - np.sum(left * up, axis=-1, keepdims=True) * up
+    across /= np.linalg.norm(across, axis=-1, keepdims=True)
+    for s, outward in (("Left", 1.0), ("Right", -1.0)):
+        # the arm moved out along the upper arm and forward, then shoulder to hand in and down, unchanged in shape
+        whole = -(sdk_joints.ARM_INWARD * outward * across + sdk_joints.ARM_DOWN * up) * torso[:, None]
+        assert np.all(np.sum(whole * across, axis=-1) * outward < 0) and np.all(np.sum(whole * up, axis=-1) < 0)
         upper = mh[:, J(f"Elbow{s}")] - mh[:, J(f"Shoulder{s}")]
         out = upper / np.linalg.norm(upper, axis=-1, keepdims=True) * (sdk_joints.ARM_OUT * torso)[:, None]
         out += front * (sdk_joints.ARMS_FORWARD * torso)[:, None]
         for n in ("Elbow", "Wrist", "Hand"):
-            np.testing.assert_allclose(sdk[:, J(f"{n}{s}")] - mh[:, J(f"{n}{s}")], out, atol=1e-12)
+            np.testing.assert_allclose(sdk[:, J(f"{n}{s}")] - mh[:, J(f"{n}{s}")], out + whole, atol=1e-12)
         rise = np.sum((sdk[:, J(f"Knee{s}")] - mh[:, J(f"Knee{s}")]) * up, axis=-1)
         np.testing.assert_allclose(rise, sdk_joints.KNEES_UP * torso, atol=1e-12)
         facing = np.cross(mh[:, J("HipLeft")] - mh[:, J("HipRight")], up)   # the knee goes back, not forward
         assert np.all(np.sum((sdk[:, J(f"Knee{s}")] - mh[:, J(f"Knee{s}")]) * facing, axis=-1) < 0)
+        np.testing.assert_allclose(sdk[:, J(f"Foot{s}")] - mh[:, J(f"Foot{s}")],
+                                   sdk_joints.FEET_FORWARD * torso[:, None] * front, atol=1e-12)
+        hip_forward = np.sum((sdk[:, J(f"Hip{s}")] - mh[:, J(f"Hip{s}")]) * front, axis=-1)
+        np.testing.assert_allclose(hip_forward, sdk_joints.HIPS_FORWARD * torso, atol=1e-12)
         shin = mh[:, J(f"Knee{s}")] - mh[:, J(f"Ankle{s}")]   # the ankle goes up its shin and back
         unit = lambda v: v / np.linalg.norm(v, axis=-1, keepdims=True)
         np.testing.assert_allclose(sdk[:, J(f"Ankle{s}")] - mh[:, J(f"Ankle{s}")], torso[:, None] * (
