@@ -2,22 +2,23 @@
 
 The tracker fits MakeHuman's skeleton (its body model, proposals and offsets are learned on MakeHuman bodies);
 the SDK names the same joints but places several elsewhere. Its HipCenter sits well above the hip joints' line
-(about a fifth of the torso; MakeHuman's is on it), its Spine a short way above that (MakeHuman's is mid-back),
-its hip joints are narrower (Kinect v2's, in the redistributable recordings, are 0.099 of standing height
-apart; MakeHuman's 0.132), its shoulders a little lower and narrower, its upper arm longer (Kinect v2's 0.152
-of standing height, MakeHuman's 0.137, and on real depth a little more: elbow, wrist and hand sit that much
-farther out along it), its knees a little higher and farther back (its thighs lean about 6 degrees less
-forward than the tracker's), its ankles higher up the shin and a little farther back (the tracker's lay 4 cm
-lower and 1-2 cm farther forward, median, and its shins leaned about 3 degrees farther forward), and its arms
-a little farther forward (its upper arms lean about 3 degrees more forward than the tracker's, in all four
-subject-trial groups), and its whole arm, shoulder to hand, a little nearer the midline and lower; its hip joints and feet lie a
-little farther forward.
+(about a fifth of the torso; MakeHuman's is on it), its Spine a short way above that and behind it (MakeHuman's
+is mid-back), its ShoulderCenter and head joint a little lower, its hip joints narrower (Kinect v2's, in the
+redistributable recordings, are 0.099 of standing height apart; MakeHuman's 0.132) and a little farther
+forward, its shoulders a little lower and narrower, its upper arm longer (Kinect v2's 0.152 of standing
+height, MakeHuman's 0.137, and on real depth a little more: elbow, wrist and hand sit that much farther out
+along it), its knees a little higher and farther back (its thighs lean about 6 degrees less forward than the
+tracker's), its ankles higher up the shin and a little farther back (the tracker's lay 4 cm lower and 1-2 cm
+farther forward, median, and its shins leaned about 3 degrees farther forward), its feet a little farther
+forward, its arms a little farther forward (its upper arms lean about 3 degrees more forward than the
+tracker's, in all four subject-trial groups), and its whole arm, shoulder to hand, a little nearer the midline
+and lower.
 Output in the SDK's convention means a depth-tracked take is read, retargeted and compared like one the SDK
 recorded.
 
 The amounts are fractions of the torso (the hips' midpoint to ShoulderCenter), so the same function converts
 the tracker's output and a rendered body's true joints alike (the synthetic benchmark scores against those).
-The hips' width and the upper arm come from the Kinect v2 recordings; the other fifteen numbers (no
+The hips' width and the upper arm come from the Kinect v2 recordings; the other nineteen numbers (no
 redistributable Kinect v1 skeleton shows them) are settings chosen on the real-depth benchmark's subjects 1-2,
 trial 1, as its other settings were, and they hold on subjects 3-4, not tuned on (docs/depth_tracking.md).
 """
@@ -30,7 +31,11 @@ from . import body_model_fit as bm
 
 J = KINECT_V1.index
 HIP_CENTER_UP = 0.20     # HipCenter above the hip joints' midpoint, along the torso
-SPINE_UP = 0.14          # Spine above HipCenter
+SPINE_UP = 0.12          # Spine above HipCenter ...
+SPINE_BACK = 0.05        # ... and behind it (the tracker's Spine lay 2.3-3.4 cm in front of the SDK's)
+SHOULDER_CENTER_DOWN = 0.05   # ShoulderCenter lower (the tracker's lay 2.3-2.7 cm above the SDK's) ...
+SHOULDER_CENTER_BACK = 0.03   # ... and farther back (1.3-1.5 cm in front)
+HEAD_DOWN = 0.05         # the head joint lower (2.5-2.6 cm above)
 HIPS_INWARD = 0.25       # hip joints moved this share of the way toward the midline (1 - 0.099 / 0.132)
 HIPS_UP = 0.06
 HIPS_FORWARD = 0.03      # hip joints moved this much forward (the tracker's lay 1.4-1.8 cm behind the SDK's) ...
@@ -55,7 +60,7 @@ ARM_DOWN = 0.02
 
 def to_sdk_joints(positions: np.ndarray) -> np.ndarray:
     """(..., 20, 3) Kinect v1 joints on MakeHuman's convention -> the same body's joints where the SDK puts
-    them (a copy; head and ShoulderCenter unchanged)."""
+    them (a copy)."""
     p = np.array(positions, dtype=np.float64, copy=True)
     hips = (p[..., J("HipLeft"), :] + p[..., J("HipRight"), :]) / 2
     axis = p[..., J("ShoulderCenter"), :] - hips
@@ -92,5 +97,7 @@ def to_sdk_joints(positions: np.ndarray) -> np.ndarray:
         p[..., J(f"Foot{s}"), :] += FEET_FORWARD * torso * forward
         toward(J(f"Shoulder{s}"), p[..., J("ShoulderCenter"), :], SHOULDERS_INWARD, SHOULDERS_UP)
     p[..., J("HipCenter"), :] = hips + HIP_CENTER_UP * step
-    p[..., J("Spine"), :] = p[..., J("HipCenter"), :] + SPINE_UP * step
+    p[..., J("Spine"), :] = p[..., J("HipCenter"), :] + SPINE_UP * step - SPINE_BACK * torso * forward
+    p[..., J("ShoulderCenter"), :] -= SHOULDER_CENTER_DOWN * step + SHOULDER_CENTER_BACK * torso * forward
+    p[..., J("Head"), :] -= HEAD_DOWN * step
     return p
