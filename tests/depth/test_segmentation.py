@@ -59,3 +59,41 @@ def test_rendered_person_is_found_among_furniture_and_a_bystander(data_dir, came
     tr = SkeletonTracker(gravity=seq.gravity)
     tr.update(seq.mm[0], 0.0)
     assert tr.last_mask is not None and np.array_equal(tr.last_mask, performer.mask)
+
+
+def _body_with_pieces(camera, pieces):
+    """A person-sized rounded slab (its front 2.5 m away; pre-segmented: no floor, no background) and square
+    pieces ((column, row, half size in pixels, depth m))."""
+    v, u = np.mgrid[0:480, 0:640].astype(float)
+    across = (u - 320.0) / 50.0                          # the body: 100 px (about 0.5 m) wide, 1.7 m tall
+    depth = np.where((np.abs(across) < 1) & (v > 40) & (v < 380), 2.8 - 0.3 * np.sqrt(1 - np.minimum(across ** 2, 1)),
+                     np.nan)
+    for col, row, half, z in pieces:
+        depth[row - half:row + half, col - half:col + half] = z
+    return DepthGrid.from_mm(_mm(depth), camera)
+
+
+def test_an_arm_pointing_at_the_sensor_is_attached_to_its_person(camera):
+    # a forearm seen end-on is a blob 40 cm before the chest: a component of its own, too small for a person
+    grid = _body_with_pieces(camera, [(310, 150, 12, 2.1)])
+    assert len(np.unique(connected_components(grid.valid, grid.z, 0.2)[grid.valid])) == 2
+    people = find_people(grid, None, None)
+    assert len(people) == 1
+    blob = np.zeros((480, 640), bool)
+    blob[138:162, 298:322] = True
+    cells = blob[2::4, 2::4]
+    assert people[0].mask[cells].all()
+    assert people[0].pixels == people[0].mask.sum() - cells.sum()    # its size (and centroid) stay the body's
+
+
+def test_pieces_beside_far_before_or_as_big_as_the_person_are_not_theirs(camera):
+    for piece in ((480, 150, 12, 2.1),                  # beside the body, outside its silhouette's box
+                  (310, 150, 12, 1.6),                  # 0.9 m before it: not an arm
+                  (310, 200, 48, 2.1)):                 # 40 % of its size: another thing in front of it
+        grid = _body_with_pieces(camera, [piece])
+        people = find_people(grid, None, None)
+        body = max(people, key=lambda p: p.pixels)
+        col, row, half, _ = piece
+        blob = np.zeros((480, 640), bool)
+        blob[row - half:row + half, col - half:col + half] = True
+        assert not body.mask[blob[2::4, 2::4]].any(), piece
