@@ -20,7 +20,8 @@ The amounts are fractions of the torso (the hips' midpoint to ShoulderCenter), s
 the tracker's output and a rendered body's true joints alike (the synthetic benchmark scores against those).
 The hips' width and the upper arm come from the Kinect v2 recordings; the other nineteen numbers (no
 redistributable Kinect v1 skeleton shows them) are settings chosen on the real-depth benchmark's subjects 1-2,
-trial 1, as its other settings were, and they hold on subjects 3-4, not tuned on (docs/depth_tracking.md).
+as its other settings were, and they hold on subjects 3-4 (docs/depth_tracking.md says which were chosen with
+subjects 3-4's medians in view).
 """
 from __future__ import annotations
 

@@ -87,7 +87,7 @@ def test_an_arm_pointing_at_the_sensor_is_attached_to_its_person(camera):
 
 
 def test_pieces_beside_far_before_or_as_big_as_the_person_are_not_theirs(camera):
-    for piece in ((480, 150, 12, 2.1),                  # beside the body, outside its silhouette's box
+    for piece in ((400, 150, 12, 2.45),                 # beside the body, outside its silhouette's box
                   (310, 150, 12, 1.6),                  # 0.9 m before it: not an arm
                   (310, 200, 48, 2.1)):                 # 40 % of its size: another thing in front of it
         grid = _body_with_pieces(camera, [piece])
