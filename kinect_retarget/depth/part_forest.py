@@ -21,22 +21,39 @@ BACKGROUND_DEPTH = 10.0   # metres read at a probe off the person or off the ima
 MODEL_PATH = os.fspath(ASSETS_DIR / "body_parts_forest.npz")
 
 
+def framed_grid(zb: np.ndarray) -> np.ndarray:
+    """`zb` with one BACKGROUND_DEPTH cell all round, flattened: a probe off the grid then needs a clip, not a
+    bounds test and a select."""
+    framed = np.full((zb.shape[0] + 2, zb.shape[1] + 2), BACKGROUND_DEPTH)
+    framed[1:-1, 1:-1] = zb
+    return framed.ravel()
+
+
+def _depth_differences(framed: np.ndarray, shape, rows1, cols1, offsets: np.ndarray, scale) -> np.ndarray:
+    """d(x + u) - d(x + v) read from `framed_grid` (rows1, cols1: the cells' place in it, one more than in the
+    grid; offsets (..., 2, 2) in metres, scale: cells per metre at each cell's depth)."""
+    h, w = shape
+    probe = []
+    for k in (0, 1):
+        r = rows1 + np.rint(offsets[..., k, 1] * scale).astype(np.int64)
+        c = cols1 + np.rint(offsets[..., k, 0] * scale).astype(np.int64)
+        np.clip(r, 0, h + 1, out=r)
+        np.clip(c, 0, w + 1, out=c)
+        r *= w + 2
+        r += c
+        probe.append(framed[r])
+    return probe[0] - probe[1]
+
+
 def probe_features(zb: np.ndarray, rows: np.ndarray, cols: np.ndarray, offsets: np.ndarray, cells_per_m: float):
     """(N,) or (N, K) feature values at cells (rows, cols) of the person depth grid `zb` (metres,
     BACKGROUND_DEPTH off the person): offsets (..., 2, 2) = (probe u, probe v) x (right, down) in metres;
     `cells_per_m` = focal length / grid step (a metre at 1 m spans that many cells)."""
-    h, w = zb.shape
-    z = zb[rows, cols]
-    scale = cells_per_m / z
+    scale = cells_per_m / zb[rows, cols]
+    rows1, cols1 = rows + 1, cols + 1
     if offsets.ndim == 4:   # a pool of features for every cell: broadcast (N, 1) against (K,)
-        scale, rows, cols = scale[:, None], rows[:, None], cols[:, None]
-    vals = []
-    for k in (0, 1):
-        r = rows + np.rint(offsets[..., k, 1] * scale).astype(np.int64)
-        c = cols + np.rint(offsets[..., k, 0] * scale).astype(np.int64)
-        inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
-        vals.append(np.where(inside, zb[np.clip(r, 0, h - 1), np.clip(c, 0, w - 1)], BACKGROUND_DEPTH))
-    return vals[0] - vals[1]
+        scale, rows1, cols1 = scale[:, None], rows1[:, None], cols1[:, None]
+    return _depth_differences(framed_grid(zb), zb.shape, rows1, cols1, offsets, scale)
 
 
 @dataclass(frozen=True)
@@ -56,29 +73,15 @@ class PartForest:
         return self.offsets[self.feature]
 
     def classify(self, zb: np.ndarray, rows: np.ndarray, cols: np.ndarray, cells_per_m: float) -> np.ndarray:
-        """(N, parts) float32 part probabilities of the cells (rows, cols), averaged over the trees.
-        The same features as `probe_features`, read from the grid framed by one BACKGROUND_DEPTH cell so
-        that a probe off the grid needs only a clip."""
+        """(N, parts) float32 part probabilities of the cells (rows, cols), averaged over the trees."""
         t = len(self.roots)
-        h, w = zb.shape
-        framed = np.full((h + 2, w + 2), BACKGROUND_DEPTH)
-        framed[1:-1, 1:-1] = zb
-        framed = framed.ravel()
+        framed = framed_grid(zb)
         node = np.tile(self.roots, len(rows))   # (N * trees,): each cell's trees side by side
         rr, cc = np.repeat(rows, t) + 1, np.repeat(cols, t) + 1
         scale = cells_per_m / zb[rr - 1, cc - 1]
         for _ in range(self.depth):
-            off = self.node_offsets[node]
-            probe = []
-            for k in (0, 1):
-                r = rr + np.rint(off[:, k, 1] * scale).astype(np.int64)
-                c = cc + np.rint(off[:, k, 0] * scale).astype(np.int64)
-                np.clip(r, 0, h + 1, out=r)
-                np.clip(c, 0, w + 1, out=c)
-                r *= w + 2
-                r += c
-                probe.append(framed[r])
-            node = np.where(probe[0] - probe[1] <= self.threshold[node], self.left[node], self.right[node])
+            f = _depth_differences(framed, zb.shape, rr, cc, self.node_offsets[node], scale)
+            node = np.where(f <= self.threshold[node], self.left[node], self.right[node])
         probs = self.leaf_probs[node].reshape(len(rows), t, -1).astype(np.float32)
         return probs.mean(axis=1) * (1.0 / 255.0)
 

@@ -87,3 +87,21 @@ def test_forest_classifies_as_a_node_by_node_walk_with_probe_features(rendered):
                 node = forest.left[node] if f <= forest.threshold[node] else forest.right[node]
             expect += forest.leaf_probs[node] / 255.0
         assert np.allclose(probs[i], expect / len(forest.roots), atol=1e-6), i
+
+
+def test_probe_features_read_background_off_the_grid():
+    # written out with explicit bounds, as the features are defined
+    from kinect_retarget.depth.part_forest import BACKGROUND_DEPTH, probe_features
+    rng = np.random.default_rng(11)
+    zb = np.where(rng.random((30, 40)) > 0.3, rng.uniform(1.5, 3.0, (30, 40)), BACKGROUND_DEPTH)
+    rows, cols = np.nonzero(zb < BACKGROUND_DEPTH)
+    offsets = rng.uniform(-0.8, 0.8, (25, 2, 2))          # many probes land off the 30 x 40 grid
+    got = probe_features(zb, rows, cols, offsets[None], 140.0)
+    for i in range(0, len(rows), 7):
+        for k in range(len(offsets)):
+            vals = []
+            for probe in offsets[k]:
+                r = rows[i] + int(np.rint(probe[1] * 140.0 / zb[rows[i], cols[i]]))
+                c = cols[i] + int(np.rint(probe[0] * 140.0 / zb[rows[i], cols[i]]))
+                vals.append(zb[r, c] if 0 <= r < 30 and 0 <= c < 40 else BACKGROUND_DEPTH)
+            assert got[i, k] == vals[0] - vals[1]
