@@ -22,6 +22,7 @@ from .arm_search import SIDES, J, TorsoFrame, fit_arms
 from .facing import chest_facing
 from .surface_geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
 from .limb_fit import LimbScene, _nearest_cell, fit_limb
+from .part_fit import shoulders_on_parts
 from .sides import assign_sides
 from .two_bone import unit as _unit
 
@@ -31,6 +32,7 @@ MAX_LEAN_DEG = 60.0         # a "head" farther than this from upright is taken f
 AXIS_GRAVITY_WEIGHT = 0.75  # torso axis = this blend of gravity's up and the torso patch's long axis
 SIDE_ON_WIDTH = 0.165       # visible chest width / height below which the torso is taken as seen side-on
 HEAD_REGION = 0.12          # fraction of height along the surface from the head's extremum: head and neck
+SHOULDERS_ON_PARTS = True   # the limbs fitted from the shoulders' confident body parts, when there are proposals
 ARM_SEARCH = True           # arms without a hand extremity: search poses against the depth (arm_search)
 BEHIND_FREE, BEHIND_COST = 0.06, 0.5   # m behind the surface a joint may sit for free; cost per metre beyond
 SUPPORT_BEHIND = 0.08       # m behind the surface seen at its pixel an elbow/knee may sit and still be tracked
@@ -92,11 +94,13 @@ class Projector:
 def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states: np.ndarray | None,
                prev_lateral: np.ndarray | None, prev_centre: np.ndarray | None = None,
                predicted: np.ndarray | None = None, settled: bool = False,
-               facing_steady: bool = False) -> FitResult | None:
+               facing_steady: bool = False, proposals=None) -> FitResult | None:
     """One frame's skeleton for the segmented person. `prev`/`prev_states`/`prev_lateral`: the last output;
     `predicted`: where the motion so far says the joints are now (continuity for left/right labels);
     `settled`: the person has been tracked past the first frames (their pose is no longer a first guess);
-    `facing_steady`: and has faced the sensor for those frames (no turn's mirror image left in the history)."""
+    `facing_steady`: and has faced the sensor for those frames (no turn's mirror image left in the history);
+    `proposals`: the frame's body-part proposals (part_proposals.propose), whose confident shoulders the limbs
+    are fitted from."""
     rows, cols = np.nonzero(mask_full)
     r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
     # the person's bounding box of the tracker's grid (no coarser: coarser cells merge arms with the body)
@@ -149,6 +153,13 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
         pos[J[f"Shoulder{s}"]] = sc + lat * sign * bm.SHOULDER_HALF_WIDTH * H - axis * bm.SHOULDER_DROP * H
         pos[J[f"Hip{s}"]] = hc_ + lat * sign * bm.HIP_HALF_WIDTH * H
         st[J[f"Shoulder{s}"]] = st[J[f"Hip{s}"]] = TRACKED
+    # once a height is measured (before that the bones have a default body's lengths, and an arm of those
+    # lengths hung from the shoulder's part misses its hand; the body model's shoulder is scaled alike), and
+    # for a chest seen from the front (turned, the forest confuses the sides)
+    front_on = not (edge_on or narrow) and facing @ -view >= np.cos(np.radians(TURNED_DEG))
+    if SHOULDERS_ON_PARTS and proposals is not None and calib.frames and front_on:
+        rc = grid.to_pixel(pos)
+        shoulders_on_parts(pos, st, proposals, lat, axis, np.all((rc >= 0) & (rc < np.array(grid.z.shape) - 1), axis=1))
     # --- limbs ---------------------------------------------------------------------------------------
     limb_specs = (("Shoulder", "Elbow", "Wrist", "Hand", bm.UPPER_ARM, bm.FOREARM, hands, 0.08, 0.08 + bm.HAND * H),
                   ("Hip", "Knee", "Ankle", "Foot", bm.THIGH, bm.SHIN, feet, 0.07, 0.15))

@@ -117,14 +117,14 @@ class SkeletonTracker:
             self._lose(ts)
             return self._none("no person in view")
         last = self.last_good
+        self.last_proposals = None if self.forest is None else propose(self.forest, grid, person.mask)
         fit = fit_person(grid, person.mask, up, self.calibration, self._prev, self._prev_states, self._lateral,
                          None if last is None else last.torso_centre, self.confidence.predict(),
-                         self.confidence.settled, self.confidence.facing_steady)
+                         self.confidence.settled, self.confidence.facing_steady, self.last_proposals)
         if fit is None or not np.all(np.isfinite(fit.positions)):
             self._lose(ts)
             return self._none("person found but no skeleton fitted")
         if self.forest is not None:
-            self.last_proposals = propose(self.forest, grid, person.mask)
             rc = grid.to_pixel(fit.positions)   # a limb the fit continued past the image's edge keeps its end
             in_view = np.all((rc >= 0) & (rc < np.array(grid.z.shape) - 1), axis=1)
             frame, turned = body_frame(fit.lateral, fit.axis), fit.turned or fit.edge_on

@@ -343,3 +343,23 @@ def test_a_hand_moved_out_along_a_short_forearm_and_a_wrist_on_its_own_part_are_
     assert seen[j("WristLeft")] and not seen[j("WristRight")] and not seen[[j("HandLeft"), j("HandRight")]].any()
     props.confidence[j("WristLeft")] = part_fit.WRIST_SEEN_CONFIDENCE / 2
     assert not part_fit.seen_on_parts(pos, pos, props, FACING, np.zeros(20, bool), turned=False)[j("WristLeft")]
+
+
+def test_shoulders_move_onto_confident_parts_before_the_arms_and_nothing_else(no_offsets):
+    pos, st = _standing_pose()
+    props = _proposals(pos)
+    props.positions[j("ShoulderLeft")] = [-0.15, 0.34, 2.58]    # the part 6 cm lower and further back
+    props.positions[j("ShoulderRight")] = [-0.02, 0.4, 2.5]     # nearer the left shoulder than its own: refused
+    props.positions[j("ElbowLeft")] = [-0.37, 0.3, 2.4]         # arms wait for the fit and apply_proposals
+    before, before_st = pos.copy(), st.copy()
+    part_fit.shoulders_on_parts(pos, st, props, np.array([-1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+    assert np.allclose(pos[j("ShoulderLeft")], [-0.15, 0.34, 2.58])
+    moved = np.flatnonzero(np.any(pos != before, axis=1))
+    assert moved.tolist() == [j("ShoulderLeft")] and np.array_equal(st, before_st)
+    # sure enough for apply_proposals, not to fit the arms from: the fit's shoulders stay
+    unsure = _proposals(before, conf=1.5 * part_fit.USE_CONFIDENCE)
+    assert part_fit.SHOULDER_FIRST_CONFIDENCE > 1.5 * part_fit.USE_CONFIDENCE
+    unsure.positions[j("ShoulderLeft")] = [-0.15, 0.34, 2.58]
+    again = before.copy()
+    part_fit.shoulders_on_parts(again, st, unsure, np.array([-1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+    assert np.array_equal(again, before)
