@@ -42,6 +42,11 @@ class DepthGrid:
         u, v = np.moveaxis(kinect_to_depth_pixel(p, c.f, c.cx, c.cy), -1, 0)
         return np.stack([(v - self.step // 2) / self.step, (u - self.step // 2) / self.step], axis=-1)
 
+    def in_view(self, points: np.ndarray) -> np.ndarray:
+        """(...,) bool: the (..., 3) points project inside the grid (not at or past its last row or column)."""
+        rc = self.to_pixel(points)
+        return np.all((rc >= 0) & (rc < np.array(self.z.shape) - 1), axis=-1)
+
 
 @dataclass
 class FloorPlane:

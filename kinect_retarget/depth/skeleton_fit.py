@@ -153,13 +153,12 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
         pos[J[f"Shoulder{s}"]] = sc + lat * sign * bm.SHOULDER_HALF_WIDTH * H - axis * bm.SHOULDER_DROP * H
         pos[J[f"Hip{s}"]] = hc_ + lat * sign * bm.HIP_HALF_WIDTH * H
         st[J[f"Shoulder{s}"]] = st[J[f"Hip{s}"]] = TRACKED
+    turned = bool(facing @ -view < np.cos(np.radians(TURNED_DEG)))
     # once a height is measured (before that the bones have a default body's lengths, and an arm of those
     # lengths hung from the shoulder's part misses its hand; the body model's shoulder is scaled alike), and
     # for a chest seen from the front (turned, the forest confuses the sides)
-    front_on = not (edge_on or narrow) and facing @ -view >= np.cos(np.radians(TURNED_DEG))
-    if SHOULDERS_ON_PARTS and proposals is not None and calib.frames and front_on:
-        rc = grid.to_pixel(pos)
-        shoulders_on_parts(pos, st, proposals, lat, axis, np.all((rc >= 0) & (rc < np.array(grid.z.shape) - 1), axis=1))
+    if SHOULDERS_ON_PARTS and proposals is not None and calib.frames and not (turned or edge_on or narrow):
+        shoulders_on_parts(pos, st, proposals, lat, axis, grid.in_view(pos))
     # --- limbs ---------------------------------------------------------------------------------------
     limb_specs = (("Shoulder", "Elbow", "Wrist", "Hand", bm.UPPER_ARM, bm.FOREARM, hands, 0.08, 0.08 + bm.HAND * H),
                   ("Hip", "Knee", "Ankle", "Foot", bm.THIGH, bm.SHIN, feet, 0.07, 0.15))
@@ -179,7 +178,6 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
         st[[J["HipCenter"], J["Spine"], J["ShoulderCenter"]]] = INFERRED
     if legs_clipped == 2:   # both legs leave the image (the SDK's "clipped bottom"): nothing checks the hips
         st[[J["HipCenter"], J["HipLeft"], J["HipRight"]]] = INFERRED
-    turned = bool(facing @ -view < np.cos(np.radians(TURNED_DEG)))
     if turned:
         for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
             st[J[name]] = INFERRED

@@ -125,8 +125,7 @@ class SkeletonTracker:
             self._lose(ts)
             return self._none("person found but no skeleton fitted")
         if self.forest is not None:
-            rc = grid.to_pixel(fit.positions)   # a limb the fit continued past the image's edge keeps its end
-            in_view = np.all((rc >= 0) & (rc < np.array(grid.z.shape) - 1), axis=1)
+            in_view = grid.in_view(fit.positions)   # a limb the fit continued past the image's edge keeps its end
             frame, turned = body_frame(fit.lateral, fit.axis), fit.turned or fit.edge_on
             before, before_st = fit.positions.copy(), fit.states.copy()
             doubt, own = apply_proposals(fit.positions, fit.states, self.last_proposals, self.calibration.height,

@@ -97,3 +97,12 @@ def test_pieces_beside_far_before_or_as_big_as_the_person_are_not_theirs(camera)
         blob = np.zeros((480, 640), bool)
         blob[row - half:row + half, col - half:col + half] = True
         assert not body.mask[blob[2::4, 2::4]].any(), piece
+
+
+def test_in_view_is_inside_the_grid_not_on_or_past_its_last_cell(camera):
+    grid = DepthGrid.from_mm(np.full((480, 640), 2000, np.uint16), camera)
+    centre = grid.xyz[60, 80]
+    last = grid.xyz[119, 159]                              # the grid's last row and column
+    beyond = centre + np.array([2.0, 0.0, 0.0])            # 2 m to the side at 2 m: out of view
+    assert grid.in_view(np.array([centre, last, beyond])).tolist() == [True, False, False]
+    assert grid.in_view(np.zeros((2, 5, 3)) + centre).shape == (2, 5)
