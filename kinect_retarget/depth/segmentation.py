@@ -180,26 +180,35 @@ def _attach_reaching_parts(grid: DepthGrid, comps: np.ndarray, labels, counts, p
     and is small beside them. The person's centroid, height and size stay the body's own."""
     if not people:
         return
+    own = [int(comps[p.mask][0]) for p in people]   # each person is one whole component
+    # sizes first, then the pieces' cells in one pass (a cluttered room has a dozen components or more)
+    small = (counts >= PIECE_MIN) & (counts <= PIECE_SHARE * max(p.pixels for p in people)) & ~np.isin(labels, own)
+    if not small.any():
+        return
+    flat = comps.ravel()
+    cells = np.flatnonzero(np.isin(flat, labels[small]))
+    cells = cells[np.argsort(flat[cells], kind="stable")]
+    ends = np.cumsum(counts[small])
+    xyz = grid.xyz.reshape(-1, 3)
+    w = comps.shape[1]
     boxes, bodies, depth = [], [], []
     for p in people:
         rows, cols = np.nonzero(p.mask)
         boxes.append((rows.min(), rows.max(), cols.min(), cols.max()))
         bodies.append(grid.xyz[p.mask][::3])
         depth.append(np.median(grid.z[p.mask]))
-    for lab, n in zip(labels, counts):
-        if n < PIECE_MIN:
-            continue
-        m = comps == lab
-        if any(p.mask[m].any() for p in people):
-            continue
-        rows, cols = np.nonzero(m)
-        pts = grid.xyz[m]
+    for piece, n in zip(np.split(cells, ends[:-1]), counts[small]):
+        rows, cols = np.divmod(piece, w)
+        pts, near = xyz[piece], None
         for i, p in enumerate(people):
             r0, r1, c0, c1 = boxes[i]
             if (n > PIECE_SHARE * p.pixels or rows.max() < r0 or rows.min() > r1 or cols.max() < c0
-                    or cols.min() > c1 or np.median(pts[:, 2]) >= depth[i]):
+                    or cols.min() > c1):
+                continue
+            near = np.median(pts[:, 2]) if near is None else near
+            if near >= depth[i]:
                 continue
             gap = np.min(np.linalg.norm(pts[::2, None, :] - bodies[i][None], axis=-1))
             if gap <= REACH_GAP:
-                people[i].mask = p.mask | m
+                p.mask.flat[piece] = True
                 break
