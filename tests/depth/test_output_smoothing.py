@@ -3,7 +3,9 @@ import numpy as np
 
 from kinect_retarget.core.filters import jitter
 from kinect_retarget.core.skeletons import INFERRED, KINECT_V1, NOT_TRACKED, TRACKED
-from kinect_retarget.depth.output_smoothing import ARMS, BODY, MAX_TRAIL, OutputSmoothing
+from kinect_retarget.depth import output_smoothing
+from kinect_retarget.depth.output_smoothing import (ARMS, BODY, KNEES_ANKLES, MAX_TRAIL, REST_MAX_MOVE, OutputSmoothing,
+                                                    _robust_line_end)
 
 J = KINECT_V1.index
 
@@ -35,11 +37,40 @@ def test_a_performer_standing_still_jitters_far_less():
 
 def test_arms_follow_a_quick_move_sooner_than_the_body():
     pose = still_pose()
-    moved = pose + [0.3, 0.0, 0.0]   # everything 30 cm to the side at once
-    out = _run([pose] * 10 + [moved] * 4)
-    left_behind = np.linalg.norm(out[-3] - moved, axis=1)
+    moving = [pose + [0.04 * k, 0.0, 0.0] for k in range(1, 9)]   # everything sideways at 1.2 m/s
+    out = _run([pose] * 10 + moving)
+    left_behind = np.linalg.norm(out[-3] - moving[-3], axis=1)
     assert left_behind[ARMS].max() < left_behind[BODY].min()
-    assert np.linalg.norm(out[-4:] - moved, axis=-1).max() <= MAX_TRAIL + 1e-12   # never far behind
+    behind = np.linalg.norm(out[-8:] - moving, axis=-1)
+    assert behind.max() <= MAX_TRAIL + REST_MAX_MOVE + 1e-12   # never far behind (a start from rest is held most)
+    assert behind[-3:].max() <= MAX_TRAIL + 1e-12   # and once moving, the line lets go
+
+
+def test_a_still_knee_ignores_single_frames_off_and_a_moving_one_is_not_held_back(monkeypatch):
+    pose = still_pose()
+    frames = [pose.copy() for _ in range(30)]
+    knee = J("KneeLeft")
+    for k in (10, 14, 20, 21):   # single frames (and a pair) 8 cm off, as the fit's and the part's knees differ
+        frames[k][knee] += [0.0, -0.08, 0.0]
+    out = _run(frames)
+    assert np.linalg.norm(out[:, knee] - pose[knee], axis=1).max() < 0.01
+    walking = [pose + [0.0, 0.0, 0.04 * k] for k in range(30)]   # 1.2 m/s toward the sensor
+    lag = np.linalg.norm(_run(walking)[:, KNEES_ANKLES] - np.array(walking)[:, KNEES_ANKLES], axis=-1)
+    assert lag.max() <= MAX_TRAIL + 1e-12
+    monkeypatch.setattr(output_smoothing, "REST_FRAMES", 1)   # without the line, the filter lets them through
+    assert np.linalg.norm(_run(frames)[:, knee] - pose[knee], axis=1).max() > 0.04
+
+
+def test_the_robust_line_follows_a_steady_move_and_ignores_one_place_off():
+    times = np.arange(7) / 30.0
+    window = np.zeros((7, 2, 3))
+    window[:, 0, 0] = np.arange(7) * 0.01          # 0.3 m/s along x
+    window[3, 1] = [0.0, 0.5, 0.0]                 # one place far off
+    end, speed = _robust_line_end(window, times, 1.0)
+    np.testing.assert_allclose(end, [[0.06, 0.0, 0.0], [0.0, 0.0, 0.0]], atol=1e-12)
+    np.testing.assert_allclose(speed, [0.3, 0.0], atol=1e-9)
+    half, _ = _robust_line_end(window, times, 0.5)
+    np.testing.assert_allclose(half[0], [0.045, 0.0, 0.0], atol=1e-12)   # half the slope: 1.5 frames behind
 
 
 def test_the_first_frame_and_a_forgotten_performer_start_from_their_raw_joints():
@@ -82,4 +113,4 @@ def test_the_tracker_steadies_what_it_reports_and_reports_raw_joints_when_asked(
     expected = _run(raw, states, seq.times)
     np.testing.assert_allclose(np.array([p for p, _ in runs[True]]), expected, atol=1e-12)
     trail = np.linalg.norm(expected - raw, axis=-1)
-    assert 0.005 < trail.max() <= MAX_TRAIL + 1e-12   # the filter did something, and never lags far behind
+    assert 0.005 < trail.max() <= MAX_TRAIL + REST_MAX_MOVE + 1e-12   # it did something, and never lags far behind
