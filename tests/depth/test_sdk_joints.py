@@ -84,3 +84,43 @@ def test_the_tracker_reports_the_sdk_hip_centre_not_makehumans(rendered):
     to_sdk = np.linalg.norm(hc - to_sdk_joints(seq.joints[frames])[:, J("HipCenter")], axis=-1).mean()
     to_mh = np.linalg.norm(hc - seq.joints[frames, J("HipCenter")], axis=-1).mean()
     assert to_sdk < 0.05 and to_mh > to_sdk + 0.04, (to_sdk, to_mh)
+
+
+def _across_line(p, s, direction):
+    """The knee's place across its hip-ankle line along `direction` (made perpendicular to the line)."""
+    hip, knee, ankle = p[J(f"Hip{s}")], p[J(f"Knee{s}")], p[J(f"Ankle{s}")]
+    line = (ankle - hip) / np.linalg.norm(ankle - hip)
+    d = direction - (direction @ line) * line
+    return (knee - hip) @ (d / np.linalg.norm(d))
+
+
+def test_a_knee_bent_backward_or_sideways_is_brought_within_the_sdks_range(rendered, monkeypatch):
+    seq, _ = rendered
+    mh = seq.joints[5].copy()
+    hips = (mh[J("HipLeft")] + mh[J("HipRight")]) / 2
+    torso = np.linalg.norm(mh[J("ShoulderCenter")] - hips)
+    up = (mh[J("ShoulderCenter")] - hips) / torso
+    left = mh[J("HipLeft")] - mh[J("HipRight")]
+    front = np.cross(left, up)
+    front /= np.linalg.norm(front)
+    across = left - (left @ up) * up
+    across /= np.linalg.norm(across)   # toward the performer's left: the right knee's outward is -across
+    bent = mh.copy()
+    bent[J("KneeLeft")] -= 0.25 * front      # 25 cm backward
+    bent[J("KneeRight")] += 0.03 * across     # 3 cm inward
+    far = mh.copy()
+    far[J("KneeRight")] -= 0.30 * across      # 30 cm outward
+    clamped = {name: to_sdk_joints(p) for name, p in (("plain", mh), ("bent", bent), ("far", far))}
+    behind, inward, most = sdk_joints.KNEE_BEHIND_MAX, sdk_joints.KNEE_OUTWARD[0], sdk_joints.KNEE_SIDEWAYS_MOVE
+    monkeypatch.setattr(sdk_joints, "KNEE_BEHIND_MAX", np.inf)
+    monkeypatch.setattr(sdk_joints, "KNEE_OUTWARD", (-np.inf, np.inf))
+    free = {name: to_sdk_joints(p) for name, p in (("plain", mh), ("bent", bent), ("far", far))}
+    np.testing.assert_array_equal(clamped["plain"], free["plain"])   # a knee within the range stays
+    assert _across_line(free["bent"], "Left", -front) > behind * torso + 0.05
+    assert abs(_across_line(clamped["bent"], "Left", -front) - behind * torso) < 1e-9
+    assert _across_line(free["bent"], "Right", -across) < inward * torso
+    assert abs(_across_line(clamped["bent"], "Right", -across) - inward * torso) < 1e-9
+    sideways = np.linalg.norm(clamped["far"][J("KneeRight")] - free["far"][J("KneeRight")])
+    assert abs(sideways - most * torso) < 1e-9   # far out: moved that much only
+    np.testing.assert_array_equal(np.delete(clamped["far"], [J("KneeRight")], 0),
+                                  np.delete(free["far"], [J("KneeRight")], 0))
