@@ -12,15 +12,16 @@ tracker's), its ankles higher up the shin and a little farther back (the tracker
 farther forward, median, and its shins leaned about 3 degrees farther forward), its feet a little farther
 forward, its arms a little farther forward (its upper arms lean about 3 degrees more forward than the
 tracker's, in all four subject-trial groups), and its whole arm, shoulder to hand, a little nearer the midline
-and lower.
+and lower. And it does not bend a knee backward or sideways: its knees stay within a narrow range across the
+line from hip to ankle.
 Output in the SDK's convention means a depth-tracked take is read, retargeted and compared like one the SDK
 recorded.
 
 The amounts are fractions of the torso (the hips' midpoint to ShoulderCenter), so the same function converts
 the tracker's output and a rendered body's true joints alike (the synthetic benchmark scores against those).
-The hips' width and the upper arm come from the Kinect v2 recordings; the other nineteen numbers (no
-redistributable Kinect v1 skeleton shows them) are settings chosen on the real-depth benchmark's subjects 1-2,
-as its other settings were, and they hold on subjects 3-4 (docs/depth_tracking.md says which were chosen with
+The hips' width and the upper arm come from the Kinect v2 recordings; the other nineteen numbers and the knees'
+range (three percentiles and a bound on the move; no redistributable Kinect v1 skeleton shows them) are
+settings chosen on the real-depth benchmark's subjects 1-2, as its other settings were, and they hold on subjects 3-4 (docs/depth_tracking.md says which were chosen with
 subjects 3-4's medians in view).
 """
 from __future__ import annotations
