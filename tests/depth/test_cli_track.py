@@ -6,6 +6,7 @@ import pytest
 
 from kinect_retarget.cli import main
 from kinect_retarget.core.skeletons import NOT_TRACKED
+from kinect_retarget.depth.output_smoothing import MAX_TRAIL, REST_MAX_MOVE
 from kinect_retarget.depth.sdk_joints import to_sdk_joints
 from kinect_retarget.takes import load_take
 
@@ -30,7 +31,8 @@ def test_track_raw_joints_skips_only_the_smoothing(rendered, tmp_path):
     a, b = load_take(steady), load_take(raw)
     np.testing.assert_array_equal(a.states, b.states)
     trail = np.linalg.norm(a.positions - b.positions, axis=-1)
-    assert 0.0 < trail.max() <= 0.03 + 1e-4   # steadied, never more than 3 cm from the raw joints (float32 takes)
+    most = MAX_TRAIL + REST_MAX_MOVE + 1e-4   # the filter's bound and the rest line's (float32 takes)
+    assert 0.0 < trail.max() <= most   # steadied, never far from the raw joints
 
 
 def test_track_raw_only_capture_with_device_ticks(rendered, tmp_path):
