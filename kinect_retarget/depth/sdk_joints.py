@@ -13,14 +13,14 @@ farther forward, median, and its shins leaned about 3 degrees farther forward), 
 forward, its arms a little farther forward (its upper arms lean about 3 degrees more forward than the
 tracker's, in all four subject-trial groups), and its whole arm, shoulder to hand, a little nearer the midline
 and lower. And it does not bend a knee backward or sideways: its knees stay within a narrow range across the
-line from hip to ankle.
+line from hip to ankle; nor does it put an ankle in front of its foot.
 Output in the SDK's convention means a depth-tracked take is read, retargeted and compared like one the SDK
 recorded.
 
 The amounts are fractions of the torso (the hips' midpoint to ShoulderCenter), so the same function converts
 the tracker's output and a rendered body's true joints alike (the synthetic benchmark scores against those).
 The hips' width and the upper arm come from the Kinect v2 recordings; the other nineteen numbers and the knees'
-range (three percentiles and a bound on the move; no redistributable Kinect v1 skeleton shows them) are
+and ankles' ranges (four percentiles and a bound on the move; no redistributable Kinect v1 skeleton shows them) are
 settings chosen on the real-depth benchmark's subjects 1-2, as its other settings were, and they hold on subjects 3-4 (docs/depth_tracking.md says which were chosen with
 subjects 3-4's medians in view).
 """
@@ -50,6 +50,7 @@ KNEES_UP = 0.05          # ... and up
 KNEE_BEHIND_MAX = 0.095  # no farther behind it than this
 KNEE_OUTWARD = (-0.026, 0.071)   # nor farther inward or outward (toward the performer's own side) than these,
 KNEE_SIDEWAYS_MOVE = 0.1         # moved sideways no more than this
+ANKLE_BEFORE_FOOT = 0.004   # no ankle farther forward of its foot than this (the SDK's 95th percentile; median -0.063)
 ANKLES_BACK = 0.03       # ankles moved this much back (1.5 cm on a 0.5 m torso) ...
 ANKLES_UP_SHIN = 0.07    # ... and up along the shin (3.5 cm: the shin's direction is kept)
 ARMS_FORWARD = 0.03      # elbow, wrist and hand moved this much forward (the SDK's upper arms lean 3 degrees more so)
@@ -101,6 +102,8 @@ def to_sdk_joints(positions: np.ndarray) -> np.ndarray:
         toward(J(f"Hip{s}"), hips, HIPS_INWARD, HIPS_UP)
         p[..., J(f"Hip{s}"), :] += HIPS_FORWARD * torso * forward
         p[..., J(f"Foot{s}"), :] += FEET_FORWARD * torso * forward
+        before = np.sum((p[..., J(f"Ankle{s}"), :] - p[..., J(f"Foot{s}"), :]) * forward, axis=-1, keepdims=True)
+        p[..., J(f"Ankle{s}"), :] -= np.maximum(before - ANKLE_BEFORE_FOOT * torso, 0.0) * forward
         _knee_within_sdk_range(p, s, forward, across * (1.0 if s == "Left" else -1.0), torso)
         toward(J(f"Shoulder{s}"), p[..., J("ShoulderCenter"), :], SHOULDERS_INWARD, SHOULDERS_UP)
     p[..., J("HipCenter"), :] = hips + HIP_CENTER_UP * step

@@ -124,3 +124,26 @@ def test_a_knee_bent_backward_or_sideways_is_brought_within_the_sdks_range(rende
     assert abs(sideways - most * torso) < 1e-9   # far out: moved that much only
     np.testing.assert_array_equal(np.delete(clamped["far"], [J("KneeRight")], 0),
                                   np.delete(free["far"], [J("KneeRight")], 0))
+
+
+def test_an_ankle_in_front_of_its_foot_is_moved_back_to_the_sdks_limit(rendered, monkeypatch):
+    seq, _ = rendered
+    mh = seq.joints[5].copy()
+    hips = (mh[J("HipLeft")] + mh[J("HipRight")]) / 2
+    torso = np.linalg.norm(mh[J("ShoulderCenter")] - hips)
+    up = (mh[J("ShoulderCenter")] - hips) / torso
+    front = np.cross(mh[J("HipLeft")] - mh[J("HipRight")], up)
+    front /= np.linalg.norm(front)
+    ahead = mh.copy()
+    ahead[J("AnkleLeft")] = ahead[J("FootLeft")] + 0.10 * front + 0.06 * up   # 10 cm in front of its foot
+    limit = sdk_joints.ANKLE_BEFORE_FOOT
+    sdk = to_sdk_joints(ahead)
+    before = (sdk[J("AnkleLeft")] - sdk[J("FootLeft")]) @ front
+    assert abs(before - limit * torso) < 1e-9
+    monkeypatch.setattr(sdk_joints, "ANKLE_BEFORE_FOOT", np.inf)
+    free = to_sdk_joints(ahead)
+    assert (free[J("AnkleLeft")] - free[J("FootLeft")]) @ front > limit * torso + 0.05
+    np.testing.assert_array_equal(sdk[J("AnkleRight")], free[J("AnkleRight")])   # one behind its foot stays
+    np.testing.assert_allclose(sdk[J("AnkleLeft")] - free[J("AnkleLeft")],
+                               -(((free[J("AnkleLeft")] - free[J("FootLeft")]) @ front) - limit * torso) * front,
+                               atol=1e-12)   # straight back, nothing else
