@@ -94,17 +94,21 @@ def _across_line(p, s, direction):
     return (knee - hip) @ (d / np.linalg.norm(d))
 
 
-def test_a_knee_bent_backward_or_sideways_is_brought_within_the_sdks_range(rendered, monkeypatch):
-    seq, _ = rendered
-    mh = seq.joints[5].copy()
+def _torso_frame(mh):
+    """(torso length, up, front, across toward the performer's left) of one MakeHuman pose (20, 3)."""
     hips = (mh[J("HipLeft")] + mh[J("HipRight")]) / 2
     torso = np.linalg.norm(mh[J("ShoulderCenter")] - hips)
     up = (mh[J("ShoulderCenter")] - hips) / torso
     left = mh[J("HipLeft")] - mh[J("HipRight")]
     front = np.cross(left, up)
-    front /= np.linalg.norm(front)
     across = left - (left @ up) * up
-    across /= np.linalg.norm(across)   # toward the performer's left: the right knee's outward is -across
+    return torso, up, front / np.linalg.norm(front), across / np.linalg.norm(across)
+
+
+def test_a_knee_bent_backward_or_sideways_is_brought_within_the_sdks_range(rendered, monkeypatch):
+    seq, _ = rendered
+    mh = seq.joints[5].copy()
+    torso, up, front, across = _torso_frame(mh)   # the right knee's outward is -across
     bent = mh.copy()
     bent[J("KneeLeft")] -= 0.25 * front      # 25 cm backward
     bent[J("KneeRight")] += 0.03 * across     # 3 cm inward
@@ -129,11 +133,7 @@ def test_a_knee_bent_backward_or_sideways_is_brought_within_the_sdks_range(rende
 def test_an_ankle_in_front_of_its_foot_is_moved_back_to_the_sdks_limit(rendered, monkeypatch):
     seq, _ = rendered
     mh = seq.joints[5].copy()
-    hips = (mh[J("HipLeft")] + mh[J("HipRight")]) / 2
-    torso = np.linalg.norm(mh[J("ShoulderCenter")] - hips)
-    up = (mh[J("ShoulderCenter")] - hips) / torso
-    front = np.cross(mh[J("HipLeft")] - mh[J("HipRight")], up)
-    front /= np.linalg.norm(front)
+    torso, up, front, _ = _torso_frame(mh)
     ahead = mh.copy()
     ahead[J("AnkleLeft")] = ahead[J("FootLeft")] + 0.10 * front + 0.06 * up   # 10 cm in front of its foot
     limit = sdk_joints.ANKLE_BEFORE_FOOT
