@@ -20,9 +20,9 @@ recorded.
 The amounts are fractions of the torso (the hips' midpoint to ShoulderCenter), so the same function converts
 the tracker's output and a rendered body's true joints alike (the synthetic benchmark scores against those).
 The hips' width and the upper arm come from the Kinect v2 recordings; the other nineteen numbers and the knees'
-and ankles' ranges (four percentiles and a bound on the move; no redistributable Kinect v1 skeleton shows them) are
-settings chosen on the real-depth benchmark's subjects 1-2, as its other settings were, and they hold on subjects 3-4 (docs/depth_tracking.md says which were chosen with
-subjects 3-4's medians in view).
+and ankles' ranges (four percentiles and a bound on the move; no redistributable Kinect v1 skeleton shows
+them) are settings chosen on the real-depth benchmark's subjects 1-2, as its other settings were, and they
+hold on subjects 3-4 (docs/depth_tracking.md says which were chosen with subjects 3-4's medians in view).
 """
 from __future__ import annotations
 
@@ -120,7 +120,7 @@ def _knee_within_sdk_range(p: np.ndarray, side: str, forward: np.ndarray, outwar
     does not bend a knee backward or sideways: on the real benchmark's subjects 1-2 its knees lay 2.5 cm behind
     the line, median (4.6 cm at the 95th percentile), and 0.034 of the torso outward (-0.026 to 0.071 from the
     5th to the 95th percentile), while the tracker's, from a body part or the leg's fit, lay beyond those in
-    twice to four times as many samples (22 cm behind at the 99th percentile)."""
+    27 % and 33 % of samples (the SDK's 5 % and 10 %; 22 cm behind at the 99th percentile)."""
     hip, knee, ankle = (J(f"{n}{side}") for n in ("Hip", "Knee", "Ankle"))
     line = p[..., ankle, :] - p[..., hip, :]
     line /= np.maximum(np.linalg.norm(line, axis=-1, keepdims=True), 1e-9)
