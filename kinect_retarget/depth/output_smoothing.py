@@ -65,11 +65,11 @@ class OutputSmoothing:
         """Filter (20, 3) `positions` in place; `timestamp` in seconds (not finite: one frame at 30 Hz)."""
         t = float(timestamp) if math.isfinite(timestamp) else None
         now = t if t is not None else (self._recent[-1][0] + 1 / 30.0 if self._recent else 0.0)
-        self._recent = (self._recent + [(now, positions[RESTING].copy())])[-REST_FRAMES:]
+        found = positions[RESTING]   # (a copy)
+        self._recent = (self._recent + [(now, found)])[-REST_FRAMES:]
         if len(self._recent) >= 3:
             times = np.array([when for when, _ in self._recent])
             end, speed = _robust_line_end(np.stack([p for _, p in self._recent]), times, REST_SLOPE)
-            found = positions[RESTING]
             move = end - found
             move *= np.minimum(1.0, REST_MAX_MOVE / np.maximum(np.linalg.norm(move, axis=1), 1e-9))[:, None]
             slow = speed <= REST_SPEED

@@ -94,7 +94,7 @@ def to_sdk_joints(positions: np.ndarray) -> np.ndarray:
     for s, outward in (("Left", 1.0), ("Right", -1.0)):
         for n in ("Shoulder", "Elbow", "Wrist", "Hand"):
             p[..., J(f"{n}{s}"), :] -= (ARM_INWARD * outward * across + ARM_DOWN * up) * torso
-    for s in ("Left", "Right"):
+    for s, outward in (("Left", 1.0), ("Right", -1.0)):
         shin = p[..., J(f"Knee{s}"), :] - p[..., J(f"Ankle{s}"), :]
         shin /= np.maximum(np.linalg.norm(shin, axis=-1, keepdims=True), 1e-9)
         p[..., J(f"Ankle{s}"), :] += (ANKLES_UP_SHIN * shin - ANKLES_BACK * forward) * torso
@@ -104,7 +104,7 @@ def to_sdk_joints(positions: np.ndarray) -> np.ndarray:
         p[..., J(f"Foot{s}"), :] += FEET_FORWARD * torso * forward
         before = np.sum((p[..., J(f"Ankle{s}"), :] - p[..., J(f"Foot{s}"), :]) * forward, axis=-1, keepdims=True)
         p[..., J(f"Ankle{s}"), :] -= np.maximum(before - ANKLE_BEFORE_FOOT * torso, 0.0) * forward
-        _knee_within_sdk_range(p, s, forward, across * (1.0 if s == "Left" else -1.0), torso)
+        _knee_within_sdk_range(p, s, forward, outward * across, torso)
         toward(J(f"Shoulder{s}"), p[..., J("ShoulderCenter"), :], SHOULDERS_INWARD, SHOULDERS_UP)
     p[..., J("HipCenter"), :] = hips + HIP_CENTER_UP * step
     p[..., J("Spine"), :] = p[..., J("HipCenter"), :] + SPINE_UP * step - SPINE_BACK * torso * forward
@@ -126,8 +126,8 @@ def _knee_within_sdk_range(p: np.ndarray, side: str, forward: np.ndarray, outwar
     line /= np.maximum(np.linalg.norm(line, axis=-1, keepdims=True), 1e-9)
     for direction, (low, high), most in ((-forward, (-np.inf, KNEE_BEHIND_MAX), np.inf),
                                          (outward, KNEE_OUTWARD, KNEE_SIDEWAYS_MOVE)):
-        across = direction - np.sum(direction * line, axis=-1, keepdims=True) * line
-        across /= np.maximum(np.linalg.norm(across, axis=-1, keepdims=True), 1e-9)
-        now = np.sum((p[..., knee, :] - p[..., hip, :]) * across, axis=-1, keepdims=True)
+        off_line = direction - np.sum(direction * line, axis=-1, keepdims=True) * line
+        off_line /= np.maximum(np.linalg.norm(off_line, axis=-1, keepdims=True), 1e-9)
+        now = np.sum((p[..., knee, :] - p[..., hip, :]) * off_line, axis=-1, keepdims=True)
         move = np.clip(np.clip(now, low * torso, high * torso) - now, -most * torso, most * torso)
-        p[..., knee, :] += move * across
+        p[..., knee, :] += move * off_line
