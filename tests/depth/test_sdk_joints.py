@@ -147,3 +147,29 @@ def test_an_ankle_in_front_of_its_foot_is_moved_back_to_the_sdks_limit(rendered,
     np.testing.assert_allclose(sdk[J("AnkleLeft")] - free[J("AnkleLeft")],
                                -(((free[J("AnkleLeft")] - free[J("FootLeft")]) @ front) - limit * torso) * front,
                                atol=1e-12)   # straight back, nothing else
+
+
+def test_hips_sunk_to_the_knees_are_lifted_along_the_torso_to_the_sdks_limit(rendered, monkeypatch):
+    seq, _ = rendered
+    mh = seq.joints[5].copy()
+    _, up, _, _ = _torso_frame(mh)
+    sunk = mh.copy()   # the pelvis down to the knees' height, as the tracker's upright torso leaves it in a deep bend
+    drop = (((mh[J("HipLeft")] + mh[J("HipRight")]) / 2 - mh[J("KneeLeft")]) @ up) * up
+    for n in ("HipCenter", "HipLeft", "HipRight", "Spine"):
+        sunk[J(n)] -= drop
+    torso, up, _, _ = _torso_frame(sunk)
+    knees = (sunk[J("KneeLeft")] + sunk[J("KneeRight")]) / 2
+    sdk = to_sdk_joints(sunk)
+    hips = sdk[J("HipCenter")] - sdk_joints.HIP_CENTER_UP * torso * up   # the hips' midpoint as lifted
+    assert abs((hips - knees) @ up - sdk_joints.HIPS_ABOVE_KNEES * torso) < 1e-9
+    before = (sunk[J("HipLeft")] + sunk[J("HipRight")]) / 2
+    assert np.linalg.norm(np.cross(hips - before, up)) < 1e-9   # straight up the torso
+    monkeypatch.setattr(sdk_joints, "HIPS_ABOVE_KNEES", -np.inf)
+    free = to_sdk_joints(sunk)
+    assert (sdk[J("HipCenter")] - free[J("HipCenter")]) @ up > 0.1
+    for n in ("ShoulderCenter", "Head", "AnkleRight", "HandLeft"):   # the pelvis moves, not the rest
+        np.testing.assert_allclose(sdk[J(n)], free[J(n)], atol=1e-12)
+    monkeypatch.undo()
+    standing = to_sdk_joints(mh)
+    monkeypatch.setattr(sdk_joints, "HIPS_ABOVE_KNEES", -np.inf)
+    np.testing.assert_array_equal(standing, to_sdk_joints(mh))   # standing hips: untouched
