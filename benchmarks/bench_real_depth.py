@@ -1,12 +1,14 @@
 """Depth -> skeleton tracking on real Kinect v1 depth, measured against the Kinect SDK's own skeleton.
 
     .venv/bin/python benchmarks/bench_real_depth.py [--subjects 1,2] [--trials 1] [--actions 1,5] [--limit N]
-                                                    [--save DIR] [--load DIR] [--raw-output]
+                                                    [--save DIR] [--load DIR] [--raw-output] [--live-smoothing]
 
 Reads ../shared/data/utd_mhad_dev/ in place (UTD-MHAD, research use only: nothing from it, or computed from
 it, goes into the repository; see its README) and skips with a message when the folder is absent. Each
 sequence is unmirrored, upsampled to 640x480 (each pixel doubled) and tracked with f = 571.26 px, as
-`python -m kinect_retarget track ... --focal 571.26` would. The tracker's output for depth frame k is scored
+`python -m kinect_retarget track ... --focal 571.26` would: the live tracker, then the recorded take's cleanup
+with its future frames (take_smoothing.py); the live tracker's own output is scored too (its summary last).
+The output for depth frame k is scored
 against the SDK skeleton of frames k-L for the lag L in 0..3 that fits that sequence best (the depth lags the
 skeleton), over frames k >= 3, all 20 joints whatever their reported state. Figures (issue 14's table):
 mean joint error, hands and wrists, directions of the 8 limb segments (mean, and the worst action's mean),
@@ -28,6 +30,7 @@ from _common import SHARED_DATA
 from kinect_retarget.core.skeletons import KINECT_V1, NOT_TRACKED, TRACKED
 from kinect_retarget.depth.depth_camera import DepthCamera
 from kinect_retarget.depth.skeleton_tracker import SkeletonTracker, TrackerSettings
+from kinect_retarget.depth.take_smoothing import smooth_recorded_joints
 
 DATA = SHARED_DATA / "utd_mhad_dev"
 FOCAL_640 = 571.26
@@ -163,6 +166,8 @@ def main() -> None:
                     "track without body parts")
     ap.add_argument("--raw-output", action="store_true", help="score the tracker's joints before its output "
                     "smoothing (TrackerSettings.steady_output = False)")
+    ap.add_argument("--live-smoothing", action="store_true", help="score the live tracker's output as the take "
+                    "(no cleanup with future frames, as `track --live-smoothing` writes)")
     ap.add_argument("--load", help="score positions/states saved by --save instead of tracking")
     args = ap.parse_args()
     if not DATA.is_dir():
@@ -175,23 +180,26 @@ def main() -> None:
     if args.forest:
         settings.part_forest = None if args.forest == "none" else args.forest
     settings.steady_output = not args.raw_output
-    rows, lat_all, t0 = [], [], time.perf_counter()
+    rows, live_rows, lat_all, t0 = [], [], [], time.perf_counter()
     for a, s, t, path in seqs:
         depth, sdk = load(path)
         if args.limit:
             depth, sdk = depth[:args.limit], sdk[:args.limit]
         if args.load:
             with np.load(Path(args.load) / f"{path.stem}.npz") as d:
-                pos, st, height = d["pos"], d["st"], float(d["height"])
+                live, st, height = d["live"] if "live" in d else d["pos"], d["st"], float(d["height"])
         else:
-            pos, st, lat, height = track(depth, settings)
+            live, st, lat, height = track(depth, settings)
             lat_all.append(lat)
-            if args.save:
-                Path(args.save).mkdir(parents=True, exist_ok=True)
-                np.savez(Path(args.save) / f"{path.stem}.npz", pos=pos, st=st, height=height)
+        cleaned = settings.steady_output and not args.live_smoothing
+        pos = smooth_recorded_joints(live, st, np.arange(len(live)) / 30.0) if cleaned else live
+        if args.save:
+            Path(args.save).mkdir(parents=True, exist_ok=True)
+            np.savez(Path(args.save) / f"{path.stem}.npz", pos=pos, live=live, st=st, height=height)
         r = score(pos, st, sdk)
         r.update(action=a, subject=s, trial=t)
         rows.append(r)
+        live_rows.append(dict(score(live, st, sdk), action=a, subject=s, trial=t))
         f = pool([r])
         print(f"  {path.stem:11s} {len(depth):3d} frames, lag {r['lag']}, height {height:.2f} m: mean {f['mean']:5.1f} cm"
               f", hands+wrists {f['hw']:5.1f}, limbs {f['seg']:5.1f} deg, tracked {f['tracked']:3.0f} %, "
@@ -200,6 +208,12 @@ def main() -> None:
         print("no sequences selected")
         return
     report(rows)
+    if settings.steady_output and not args.live_smoothing:
+        print("\nthe live tracker's own output (what the live puppet gets: no future frames)")
+        print(HEADER)
+        for t in sorted({r["trial"] for r in live_rows}):
+            print(line(f"trial {t}, all subjects", [r for r in live_rows if r["trial"] == t]))
+        print(line("all", live_rows))
     if lat_all:
         lat = np.concatenate(lat_all)
         print(f"speed while scoring: {1.0 / lat.mean():.1f} frames/s, p95 {np.percentile(lat, 95) * 1e3:.1f} ms "

@@ -25,6 +25,8 @@ def add_parsers(subparsers) -> None:
     p.add_argument("--focal", type=float, default=575.0, help="depth focal length in pixels (default 575)")
     p.add_argument("--raw-joints", action="store_true", help="write the joints before the tracker's own "
                    "smoothing (steadied like the Kinect SDK's by default; docs/depth_tracking.md, step 14)")
+    p.add_argument("--live-smoothing", action="store_true", help="write the joints as the live tracker "
+                   "reports them: without the recorded take's cleanup with its future frames (step 15)")
     p.set_defaults(handler=run_track)
 
 
@@ -65,7 +67,8 @@ def run_track(args) -> int:
         if sys.stderr.isatty() and (i % 30 == 0 or i == n):
             print(f"\rtracking {i}/{n}", end="" if i < n else "\n", file=sys.stderr)
     settings = TrackerSettings(steady_output=not args.raw_joints)
-    take = track_depth_frames(mm, times, DepthCamera(f=args.focal), gravity, settings, progress=progress)
+    take = track_depth_frames(mm, times, DepthCamera(f=args.focal), gravity, settings, progress=progress,
+                              cleanup=not args.live_smoothing)
     krtake.write(args.out, take)
     found = float(np.mean(take.any_tracked))
     print(f"{args.out}: {take.frame_count} frames, skeleton in {found * 100:.0f} % of them, "

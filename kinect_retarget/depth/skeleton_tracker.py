@@ -29,6 +29,7 @@ from .part_proposals import propose
 from .sdk_joints import to_sdk_joints
 from .segmentation import DepthGrid, FloorPlane, PersonMask, find_people, fit_floor
 from .skeleton_fit import FitResult, fit_person
+from .take_smoothing import smooth_recorded_joints
 
 LOST_RESET_S = 0.5   # forget the previous pose after this long without the person (then re-acquire)
 CALIBRATION_FRAMES = 15    # with a floor: standing measurements blended into the height
@@ -221,8 +222,12 @@ class SkeletonTracker:
 
 
 def track_depth_frames(depth_mm: np.ndarray, times: np.ndarray, camera: DepthCamera | None = None,
-                       gravity=None, settings: TrackerSettings | None = None, progress=None) -> Take:
-    """Run the tracker over a capture: (F, 480, 640) millimetres and (F,) seconds -> a Kinect v1 Take."""
+                       gravity=None, settings: TrackerSettings | None = None, progress=None,
+                       cleanup: bool = True) -> Take:
+    """Run the tracker over a capture: (F, 480, 640) millimetres and (F,) seconds -> a Kinect v1 Take.
+    `cleanup`: with steady output, the recorded take's joints are also cleaned with its future frames
+    (take_smoothing.py: no lag, wrong limbs of a frame or two dropped); False gives what the live tracker
+    reported."""
     tracker = SkeletonTracker(camera, gravity, settings)
     n = len(depth_mm)
     pos = np.zeros((n, 20, 3))
@@ -231,6 +236,8 @@ def track_depth_frames(depth_mm: np.ndarray, times: np.ndarray, camera: DepthCam
         pos[i], st[i] = tracker.update(depth_mm[i], times[i])
         if progress is not None:
             progress(i + 1, n)
+    if cleanup and tracker.settings.steady_output:
+        pos = smooth_recorded_joints(pos, st, times)
     rate = 30.0 if n < 2 else float(np.clip(round(1.0 / np.median(np.diff(times)), 3), 1, 240))
     return Take(KINECT_V1, pos, st, np.asarray(times, dtype=np.float64), rate, "depth",
                 {"tracker": "kinect_retarget.depth", "calibrated_height_m": round(tracker.calibration.height, 3)})

@@ -8,6 +8,7 @@ from kinect_retarget.cli import main
 from kinect_retarget.core.skeletons import NOT_TRACKED
 from kinect_retarget.depth.output_smoothing import MAX_TRAIL, REST_MAX_MOVE
 from kinect_retarget.depth.sdk_joints import to_sdk_joints
+from kinect_retarget.depth.take_smoothing import smooth_recorded_joints
 from kinect_retarget.takes import load_take
 
 
@@ -23,16 +24,23 @@ def test_track_capture_writes_a_take(rendered, tmp_path, capsys):
     assert "skeleton in 100 %" in capsys.readouterr().out
 
 
-def test_track_raw_joints_skips_only_the_smoothing(rendered, tmp_path):
+def test_track_cleans_the_recorded_take_and_its_flags_skip_the_smoothing(rendered, tmp_path):
     seq, path = rendered
-    steady, raw = tmp_path / "steady.krtake", tmp_path / "raw.krtake"
-    assert main(["track", str(path), "--out", str(steady)]) == 0
-    assert main(["track", str(path), "--out", str(raw), "--raw-joints"]) == 0
-    a, b = load_take(steady), load_take(raw)
-    np.testing.assert_array_equal(a.states, b.states)
-    trail = np.linalg.norm(a.positions - b.positions, axis=-1)
+    takes = {}
+    for name, flags in (("take", []), ("live", ["--live-smoothing"]), ("raw", ["--raw-joints"])):
+        out = tmp_path / f"{name}.krtake"
+        assert main(["track", str(path), "--out", str(out), *flags]) == 0
+        takes[name] = load_take(out)
+    take, live, raw = takes["take"], takes["live"], takes["raw"]
+    np.testing.assert_array_equal(take.states, raw.states)
+    np.testing.assert_array_equal(live.states, raw.states)
+    trail = np.linalg.norm(live.positions - raw.positions, axis=-1)
     most = MAX_TRAIL + REST_MAX_MOVE + 1e-4   # the filter's bound and the rest line's (float32 takes)
-    assert 0.0 < trail.max() <= most   # steadied, never far from the raw joints
+    assert 0.0 < trail.max() <= most   # the live tracker's steadying: never far from the raw joints
+    # by default the recorded take is also cleaned with its future frames (float32 takes: 1e-5 m)
+    np.testing.assert_allclose(take.positions, smooth_recorded_joints(live.positions, live.states, live.times),
+                               atol=1e-5)
+    assert np.abs(take.positions - live.positions).max() > 1e-3
 
 
 def test_track_raw_only_capture_with_device_ticks(rendered, tmp_path):
