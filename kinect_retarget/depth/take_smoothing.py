@@ -3,15 +3,15 @@
 The live tracker smooths with the frames it has seen only (output_smoothing.py), so it trades jitter against
 lag and lets a limb that is wrong for a frame or two through. A recorded capture tracked into a take
 (`track_depth_frames`, the `track` command) has its future frames too: each joint coordinate then goes
-through a centred running median of 2 * MEDIAN_HALF + 1 frames (a limb taken wrongly for one or two frames is
-dropped) and a centred Gaussian of SIGMA_FRAMES (the jitter left), with no lag: each window stays centred
-on its frame (it shrinks at the ends of a run, and a tracked joint uses the frames where it is tracked). Frames without a skeleton
-and gaps in time split the take into runs that are cleaned apart; states are kept.
+through a centred running median (5 frames for a tracked joint, 9 for an inferred one: a limb taken wrongly
+for a frame or two, or four, is dropped) and a centred Gaussian (1 and 1.5 frames: the jitter left), with no
+lag: each window stays centred on its frame (it shrinks at the ends of a run, and a tracked joint uses the
+frames where it is tracked). Frames without a skeleton and gaps in time split the take into runs that are
+cleaned apart; states are kept.
 
 On the real-depth benchmark (all 216 UTD-MHAD sequences, docs/depth_tracking.md) this took the limbs'
-directions against the Kinect SDK from 10.5 to 9.8 degrees and the joints from 5.6 to 5.3 cm; the settings
-were chosen on subjects 1-2 (a 7-frame median or a wider Gaussian bettered the limbs by up to 0.1 degree
-and worsened the hands).
+directions against the Kinect SDK from 10.5 to 9.7 degrees and the joints from 5.6 to 5.2 cm; the windows
+were chosen on subjects 1-2 (docs/depth_tracking.md, step 15, has what else was measured).
 """
 from __future__ import annotations
 
@@ -19,8 +19,10 @@ import numpy as np
 
 from ..core.skeletons import NOT_TRACKED, TRACKED
 
-MEDIAN_HALF = 2       # frames each side of the running median
-SIGMA_FRAMES = 1.0    # the Gaussian's standard deviation, in frames
+# (frames each side of the running median, the Gaussian's standard deviation in frames) for tracked joints,
+# and wider for inferred ones (the guesses for a limb not seen jitter and stray more)
+TRACKED_WINDOW = (2, 1.0)
+INFERRED_WINDOW = (4, 1.5)
 MAX_GAP_S = 0.2       # frames farther apart than this are not smoothed together
 
 
@@ -40,12 +42,14 @@ def smooth_recorded_joints(positions: np.ndarray, states: np.ndarray, times: np.
         end = i + 1
         while end < len(out) and have[end] and not gap[end - 1]:
             end += 1
-        out[i:end] = _clean_run(out[i:end], st[i:end])
+        run, run_st = out[i:end], st[i:end]
+        out[i:end] = np.where((run_st == TRACKED)[..., None], _clean_run(run, run_st, *TRACKED_WINDOW),
+                              _clean_run(run, run_st, *INFERRED_WINDOW))
         i = end
     return out
 
 
-def _clean_run(run: np.ndarray, states: np.ndarray) -> np.ndarray:
+def _clean_run(run: np.ndarray, states: np.ndarray, median_half: int, sigma: float) -> np.ndarray:
     """One run of consecutive frames: centred median, then centred Gaussian, over windows that shrink at the
     run's ends. A tracked joint is cleaned with the frames where it is tracked only: a limb found again after
     frames of guessing must not be pulled back toward the guesses."""
@@ -65,10 +69,10 @@ def _clean_run(run: np.ndarray, states: np.ndarray) -> np.ndarray:
         use = inside[..., None] & (both | (states[:, None, :] != TRACKED))   # (frames, window, joints)
         return joints[near], use
 
-    near, use = window(run, np.arange(-MEDIAN_HALF, MEDIAN_HALF + 1))
+    near, use = window(run, np.arange(-median_half, median_half + 1))
     steady = np.nanmedian(np.where(use[..., None], near, np.nan), axis=1)
-    reach = int(np.ceil(2.5 * SIGMA_FRAMES))
+    reach = int(np.ceil(2.5 * sigma))
     offsets = np.arange(-reach, reach + 1)
     near, use = window(steady, offsets)
-    weights = np.exp(-0.5 * (offsets / SIGMA_FRAMES) ** 2)[None, :, None] * use
+    weights = np.exp(-0.5 * (offsets / sigma) ** 2)[None, :, None] * use
     return np.sum(weights[..., None] * near, axis=1) / np.sum(weights, axis=1)[..., None]
