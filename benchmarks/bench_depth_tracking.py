@@ -6,9 +6,9 @@
 Renders CMU mocap (walks 131_02 and 131_01, hop 131_03, forward jumps 01_01) on the MakeHuman body as Kinect v1 depth
 (cached in $KR_DEPTH_CACHE, default /tmp/kinect_retarget_depth_cache), tracks it, prints the figures.
 The issue motions are also scored as `track` writes them from a recording (cleaned with their future frames,
-take_smoothing.py). Goals (issue 5): mean error <= 8 cm, no left/right swap > 3 frames, every joint within 15 cm or flagged,
->= 30 frames/s on one core at 640x480 input, latency <= 33 ms, robustness scenarios never NaN and
-recover within 1 s. Also prints the fraction of joint samples flagged (inferred/untracked), and the figures of
+take_smoothing.py). Goals (issue 5): mean error <= 8 cm, no left/right swap > 3 frames, every joint within
+15 cm or flagged, >= 30 frames/s on one core at 640x480 input, latency <= 33 ms, robustness scenarios never
+NaN and recover within 1 s. Also prints the fraction of joint samples flagged (inferred/untracked), and the figures of
 the development half (each motion's first half; the only one looked at while tuning) and the held-out half.
 """
 from __future__ import annotations

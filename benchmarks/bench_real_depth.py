@@ -8,9 +8,9 @@ it, goes into the repository; see its README) and skips with a message when the 
 sequence is unmirrored, upsampled to 640x480 (each pixel doubled) and tracked with f = 571.26 px, as
 `python -m kinect_retarget track ... --focal 571.26` would: the live tracker, then the recorded take's cleanup
 with its future frames (take_smoothing.py); the live tracker's own output is scored too (its summary last).
-The output for depth frame k is scored
-against the SDK skeleton of frames k-L for the lag L in 0..3 that fits that sequence best (the depth lags the
-skeleton), over frames k >= 3, all 20 joints whatever their reported state. Figures (issue 14's table):
+The output for depth frame k is scored against the SDK skeleton of frames k-L for the lag L in 0..3 that fits
+that sequence best (the depth lags the skeleton), over frames k >= 3, all 20 joints whatever their reported
+state. Figures (issue 14's table):
 mean joint error, hands and wrists, directions of the 8 limb segments (mean, and the worst action's mean),
 joint samples reported tracked (and their error), frames with a skeleton, joints within 10 cm; per subject,
 per action and for subjects 1-2 (where settings are chosen) and 3-4 (not tuned on).

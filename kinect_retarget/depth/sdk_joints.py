@@ -20,8 +20,8 @@ recorded.
 
 The amounts are fractions of the torso (the hips' midpoint to ShoulderCenter), so the same function converts
 the tracker's output and a rendered body's true joints alike (the synthetic benchmark scores against those).
-The hips' width and the upper arm come from the Kinect v2 recordings; the other nineteen numbers and the knees'
-and ankles' ranges (four percentiles and a bound on the move; no redistributable Kinect v1 skeleton shows
+The hips' width and the upper arm come from the Kinect v2 recordings; the other nineteen numbers and the knees',
+ankles' and hips' limits (five of them and a bound on the move; no redistributable Kinect v1 skeleton shows
 them) are settings chosen on the real-depth benchmark's subjects 1-2, as its other settings were, and they
 hold on subjects 3-4 (docs/depth_tracking.md says which were chosen with subjects 3-4's medians in view).
 """
