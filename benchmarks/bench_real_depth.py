@@ -180,6 +180,7 @@ def main() -> None:
     if args.forest:
         settings.part_forest = None if args.forest == "none" else args.forest
     settings.steady_output = not args.raw_output
+    cleaned = settings.steady_output and not args.live_smoothing   # as `track` writes a recording
     rows, live_rows, lat_all, t0 = [], [], [], time.perf_counter()
     for a, s, t, path in seqs:
         depth, sdk = load(path)
@@ -191,7 +192,6 @@ def main() -> None:
         else:
             live, st, lat, height = track(depth, settings)
             lat_all.append(lat)
-        cleaned = settings.steady_output and not args.live_smoothing
         pos = smooth_recorded_joints(live, st, np.arange(len(live)) / 30.0) if cleaned else live
         if args.save:
             Path(args.save).mkdir(parents=True, exist_ok=True)
@@ -208,7 +208,7 @@ def main() -> None:
         print("no sequences selected")
         return
     report(rows)
-    if settings.steady_output and not args.live_smoothing:
+    if cleaned:
         print("\nthe live tracker's own output (what the live puppet gets: no future frames)")
         print(HEADER)
         for t in sorted({r["trial"] for r in live_rows}):

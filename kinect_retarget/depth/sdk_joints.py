@@ -79,7 +79,9 @@ def to_sdk_joints(positions: np.ndarray) -> np.ndarray:
     torso = np.linalg.norm(axis, axis=-1, keepdims=True)
     up = axis / np.maximum(torso, 1e-9)
     step = torso * up   # the torso's length along its own axis
-    knees = (p[..., J("KneeLeft"), :] + p[..., J("KneeRight"), :]) / 2   # the pelvis (HipCenter, Spine) follows
+    # hips sunk toward the knees go up the torso (HipCenter and Spine follow them below); the torso's length and
+    # axis stay as measured, so the amounts below are the same fractions of the same torso
+    knees = (p[..., J("KneeLeft"), :] + p[..., J("KneeRight"), :]) / 2
     lift = np.maximum(HIPS_ABOVE_KNEES * torso - np.sum((hips - knees) * up, axis=-1, keepdims=True), 0.0) * up
     for n in ("HipLeft", "HipRight"):
         p[..., J(n), :] += lift
