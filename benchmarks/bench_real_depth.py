@@ -199,7 +199,8 @@ def main() -> None:
         r = score(pos, st, sdk)
         r.update(action=a, subject=s, trial=t)
         rows.append(r)
-        live_rows.append(dict(score(live, st, sdk), action=a, subject=s, trial=t))
+        if cleaned:   # else the take is the live output, scored above
+            live_rows.append(dict(score(live, st, sdk), action=a, subject=s, trial=t))
         f = pool([r])
         print(f"  {path.stem:11s} {len(depth):3d} frames, lag {r['lag']}, height {height:.2f} m: mean {f['mean']:5.1f} cm"
               f", hands+wrists {f['hw']:5.1f}, limbs {f['seg']:5.1f} deg, tracked {f['tracked']:3.0f} %, "
