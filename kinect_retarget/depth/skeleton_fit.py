@@ -22,12 +22,16 @@ from .arm_search import SIDES, J, TorsoFrame, fit_arms
 from .facing import chest_facing
 from .surface_geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
 from .limb_fit import LimbScene, _nearest_cell, fit_limb
-from .part_fit import shoulders_on_parts
+from .part_fit import USE_CONFIDENCE, shoulders_on_parts
 from .sides import assign_sides
 from .two_bone import unit as _unit
 
 HEAD_AXIS_WEIGHT = 0.65      # torso axis pulled this far toward the line from the torso patch to the head top
 MAX_SIDE_LEAN_DEG = 20.0    # sideways component of a lean beyond which the "head" is not trusted to tilt
+HEAD_PART_NEAR = 0.25       # m: a head extremity farther than this from a confident head part is a raised hand
+# m up its axis the torso may move to a head top so confirmed (15-25 cm up it was as often hands held at
+# the head, a basketball shot, as a torso left behind)
+FAR_HEAD_SHIFT, MAX_HEAD_SHIFT = 0.25, 0.6
 MAX_LEAN_DEG = 60.0         # a "head" farther than this from upright is taken for something else
 AXIS_GRAVITY_WEIGHT = 0.75  # torso axis = this blend of gravity's up and the torso patch's long axis
 SIDE_ON_WIDTH = 0.165       # visible chest width / height below which the torso is taken as seen side-on
@@ -122,7 +126,9 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
     for r, c, dist in extrema:
         p = xyz[r, c]
         cand.append(((r, c), p, dist, (p - centre) @ axis, (p - centre) @ lat))
-    head, shift, centre, axis, lat, facing = _pin_along_axis(xyz, mask, cand, centre, axis, lat, facing, up, calib)
+    head_part = confident_head_part(proposals)
+    head, shift, centre, axis, lat, facing = _pin_along_axis(xyz, mask, cand, centre, axis, lat, facing, up, calib,
+                                                             head_part)
 
     def along(h_frac: float) -> np.ndarray:
         return centre + axis * (h_frac - calib.torso_patch_height) * H
@@ -233,9 +239,20 @@ def _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, pre
     return d0, loose, centre, axis, lat, facing, view, edge_on, narrow
 
 
-def _pin_along_axis(xyz, mask, cand, centre, axis, lat, facing, up, calib):
+def confident_head_part(proposals) -> np.ndarray | None:
+    """The forest's head proposal where it is confident (the forest's surest part), else None."""
+    if proposals is None:
+        return None
+    head = J["Head"]
+    return proposals.positions[head] if proposals.confidence[head] >= USE_CONFIDENCE else None
+
+
+def _pin_along_axis(xyz, mask, cand, centre, axis, lat, facing, up, calib, head_part=None):
     """Where the torso sits along its axis: the head top (which may also tilt a leaning trunk) and, better,
-    the tops of the shoulders. Returns (head candidate or None, shift or None, centre, axis, lat, facing)."""
+    the tops of the shoulders. A head top farther along the axis than the torso may move in a frame is
+    believed only where the forest's confident head part (`head_part`) confirms it: the torso's disc, seeded
+    at its last place, cannot climb back up on its own after a deep bend. Returns (head candidate or None,
+    shift or None, centre, axis, lat, facing)."""
     H = calib.height
     heady = [e for e in cand if (e[1] - centre) @ up > 0 and abs(e[4]) < 0.15 * H]
     head = max(heady, key=lambda e: e[1] @ up, default=None)
@@ -259,8 +276,9 @@ def _pin_along_axis(xyz, mask, cand, centre, axis, lat, facing, up, calib):
                 axis, top, shift = leaned, l_top, l_shift
                 lat = _unit(lat - (lat @ axis) * axis)
                 facing = _unit(np.cross(lat, axis))
-        if abs(shift) > 0.15:  # not the head (a shoulder or raised hand): the torso cannot move that far
-            head, shift = None, None
+        confirmed = head_part is not None and np.linalg.norm(head[1] - head_part) < HEAD_PART_NEAR
+        if abs(shift) > 0.15 and not (confirmed and FAR_HEAD_SHIFT < shift < MAX_HEAD_SHIFT):
+            head, shift = None, None   # not the head (a shoulder or raised hand): the torso cannot move that far
     else:
         shift = None
     # the tops of the shoulders pin it better (the neck bends forward while walking; the shoulders stay)

@@ -28,7 +28,7 @@ from .part_forest import MODEL_PATH, load_forest
 from .part_proposals import propose
 from .sdk_joints import to_sdk_joints
 from .segmentation import DepthGrid, FloorPlane, PersonMask, find_people, fit_floor
-from .skeleton_fit import FitResult, fit_person
+from .skeleton_fit import HEAD_PART_NEAR, FitResult, fit_person
 from .take_smoothing import smooth_recorded_joints
 
 LOST_RESET_S = 0.5   # forget the previous pose after this long without the person (then re-acquire)
@@ -36,7 +36,6 @@ CALIBRATION_FRAMES = 15    # with a floor: standing measurements blended into th
 CALIBRATION_MEMORY = 300   # standing measurements kept for the height
 STANDING_PATCH = 0.53      # torso patch above the feet, fraction of the height, below which one is not standing
 HANDS_AT_TRACKED_WRISTS = True   # a hand off a tracked elbow and wrist, on the surface seen there, is tracked
-HEAD_PART_NEAR = 0.25      # m: a head extremity farther than this from a confident head part is a raised hand
 
 
 @dataclass
