@@ -23,12 +23,12 @@ from .body_model_fit import BodyCalibration
 from .depth_camera import DepthCamera
 from .confidence import ConfidenceCheck
 from .output_smoothing import OutputSmoothing
-from .part_fit import USE_CONFIDENCE, apply_proposals, body_frame, disagreeing, ends_seen, seen_on_parts
+from .part_fit import apply_proposals, body_frame, disagreeing, ends_seen, seen_on_parts
 from .part_forest import MODEL_PATH, load_forest
 from .part_proposals import propose
 from .sdk_joints import to_sdk_joints
 from .segmentation import DepthGrid, FloorPlane, PersonMask, find_people, fit_floor
-from .skeleton_fit import HEAD_PART_NEAR, FitResult, fit_person
+from .skeleton_fit import HEAD_PART_NEAR, FitResult, confident_head_part, fit_person
 from .take_smoothing import smooth_recorded_joints
 
 LOST_RESET_S = 0.5   # forget the previous pose after this long without the person (then re-acquire)
@@ -190,10 +190,8 @@ class SkeletonTracker:
         labels = {k: p for k, p in fit.extrema}
         if not {"head", "FootLeft", "FootRight"} <= set(labels):
             return
-        props = self.last_proposals if self.forest is not None else None
-        head = KINECT_V1.index("Head")
-        if (props is not None and props.confidence[head] >= USE_CONFIDENCE
-                and np.linalg.norm(labels["head"] - props.positions[head]) > HEAD_PART_NEAR):
+        head_part = confident_head_part(self.last_proposals if self.forest is not None else None)
+        if head_part is not None and np.linalg.norm(labels["head"] - head_part) > HEAD_PART_NEAR:
             return   # hands held over the head (a basketball shot) measured as the head: 1.81 m for 1.69
         pts = self.last_grid.xyz[person.mask]
         if self.floor is not None:
