@@ -274,14 +274,18 @@ def fit_arms(pos, st, xyz, mask, proj, frame: TorsoFrame, H, prev=None, head_reg
                 st[J[f"Wrist{s}"]] = TRACKED
 
 
-def hands_at_tracked_wrists(pos: np.ndarray, st: np.ndarray, proj) -> np.ndarray:
+def hands_at_tracked_wrists(pos: np.ndarray, st: np.ndarray, proj,
+                            backed: np.ndarray | None = None) -> np.ndarray:
     """(20,) bool: hands to report tracked because their elbow and wrist are, and the surface is seen where
-    the hand is (as the SDK reports a hand that hangs off a tracked wrist). On real depth (all 216 UTD-MHAD
-    sequences) the hands this reports tracked lay 5.5 cm from the SDK's (subjects 1-2, trial 1: 7.1), about as
+    the hand is (as the SDK reports a hand that hangs off a tracked wrist); only `backed` hands where given
+    ((20,) bool: evidence of their own, part_fit.hands_backed). On real depth (all 216 UTD-MHAD sequences)
+    the hands this reports tracked lay 5.5 cm from the SDK's (subjects 1-2, trial 1: 7.1), about as
     near as the tracked wrists."""
     out = np.zeros(20, bool)
     for s in SIDES:
         h = J[f"Hand{s}"]
+        if backed is not None and not backed[h]:
+            continue
         if st[h] != TRACKED and st[J[f"Elbow{s}"]] == TRACKED and st[J[f"Wrist{s}"]] == TRACKED:
             out[h] = proj.supported(pos[h], bm.DEPTH_INSIDE["Hand"] - 0.02)
     return out

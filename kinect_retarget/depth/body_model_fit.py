@@ -1,7 +1,7 @@
 """Body proportions for the fitted Kinect v1 skeleton, calibrated from a standing performer.
 
 Ratios to standing height H (top of head to floor) are those of the MakeHuman reference body, which match
-common anthropometric tables; calibration measures H (and where the torso patch sits) on the first frames
+common anthropometric tables; calibration measures H (and where the torso patch sits) on standing frames
 and scales them.
 """
 from __future__ import annotations
@@ -39,12 +39,3 @@ class BodyCalibration:
 
     def bone(self, ratio: float) -> float:
         return ratio * self.height
-
-    def update(self, height: float, patch_height: float, rate: float = 0.2) -> None:
-        """Blend in one standing measurement (heights in metres above the floor)."""
-        if self.frames == 0:
-            self.height, self.torso_patch_height = height, patch_height / height
-        else:
-            self.height += rate * (height - self.height)
-            self.torso_patch_height += rate * (patch_height / self.height - self.torso_patch_height)
-        self.frames += 1

@@ -67,6 +67,7 @@ DISAGREE = 0.15             # m from a confident proposal beyond which a joint i
 KNEE_NEAR_PART = True       # ... and a knee whose foot is on its own part and whose confident part is as near
 SEEN_WITHIN = 0.15          # m: a joint moved onto its confident proposal no farther than this is reported tracked
 HAND_ON_PART = 0.04         # m: a hand this near its part's proposal is on it (moved out along a forearm seen short)
+HAND_PART_NEAR = 0.10       # m: a hand this near its part's centre has evidence of its own (hands_backed)
 # a wrist this near (m) its own part's proposal, from this confidence (m²), is seen whatever its hand: two parts
 # agree on it (on the real benchmark's subjects 1-2, wrists 32 -> 52 % tracked, their error 6.9 -> 6.3 cm)
 WRIST_ON_PART, WRIST_SEEN_CONFIDENCE = 0.08, 0.0004
@@ -76,6 +77,12 @@ SEEN = np.array([n.startswith(("Head", "Shoulder", "Elbow", "Hand", "Knee")) for
 # 10-25 cm from their confident parts, moved onto them, lay 4-6 cm from the SDK's
 SEEN_ANY_MOVE = np.isin(np.arange(len(KINECT_V1.joints)), [J(n) for n in DIRECT])
 HAND_JOINTS = [J(f"Hand{s}") for s in SIDES]
+ELBOW_JOINTS = [J(f"Elbow{s}") for s in SIDES]
+# elbows are held to more: a tracked elbow a proposal moved farther than ELBOW_AGREE (m) is demoted, one moved
+# onto its part farther is not seen there, and one left beyond DISAGREE of its part is doubted from
+# DOUBTED_ARM_CONFIDENCE (disagreeing). With the torso seeded where the forest sees it (part_proposals), the
+# synthetic hop's elbows sat on the edge of 15 cm tracked-but-wrong at AGREE and USE_CONFIDENCE
+ELBOW_AGREE = 0.09
 # joints whose proposals check the fit's states (not hips, knees or spine: the fit's states stand for those)
 CHECKED = np.array([not n.startswith(("Hip", "Knee", "Spine")) for n in KINECT_V1.joints])
 OUTWARD = np.array([1.0 if "Left" in n else -1.0 if "Right" in n else 0.0 for n in KINECT_V1.joints])
@@ -271,11 +278,13 @@ def apply_proposals(pos: np.ndarray, st: np.ndarray, props, height: float, no_fl
         if KNEES and use[k] and not turned:   # turned, the forest confuses the legs' sides as it does the arms'
             pos[k], st[k] = p[k], _state(conf[k])
             knees.append(k)
-    # the fit's tracked joints stay tracked where the proposal agrees with them
+    # the fit's tracked joints stay tracked where the proposal agrees with them (elbows: within ELBOW_AGREE)
     moved = np.linalg.norm(pos - before, axis=1)
-    st[(before_st == TRACKED) & (moved <= AGREE)] = TRACKED
+    agree = np.full(20, AGREE)
+    agree[ELBOW_JOINTS] = ELBOW_AGREE
+    st[(before_st == TRACKED) & (moved <= agree)] = TRACKED
     if not PROMOTE:
-        st[(before_st == TRACKED) & (moved > AGREE)] = INFERRED
+        st[(before_st == TRACKED) & (moved > agree)] = INFERRED
     # joints seen on their own confident part, reported tracked whatever the limb above them says: feet (both
     # feet's parts apart and within the legs' reach: as sure as the SDK's feet) and knees where the fit agrees
     seen = [f for f in feet if FEET_TRACKED and conf[f] >= TRACK_CONFIDENCE]
@@ -317,6 +326,7 @@ def seen_on_parts(before: np.ndarray, pos: np.ndarray, props, frame: np.ndarray 
     if before_states is not None:
         within[before_states == TRACKED] = AGREE
     within[SEEN_ANY_MOVE] = MAX_MOVE
+    within[ELBOW_JOINTS] = np.minimum(within[ELBOW_JOINTS], ELBOW_AGREE)
     on_part = off_part < 1e-6
     on_part[HAND_JOINTS] = off_part[HAND_JOINTS] < HAND_ON_PART
     seen = SEEN & on_part & (moved > 0) & (moved <= within) & confident
@@ -338,12 +348,28 @@ def ends_seen(props) -> frozenset:
     return frozenset(label for label, joint in ends.items() if props.confidence[J(joint)] >= TRACK_CONFIDENCE)
 
 
+def hands_backed(pos: np.ndarray, props, seen: np.ndarray) -> np.ndarray:
+    """(20,) bool: hands with evidence of their own beside the arm above them: their wrist seen on its part
+    (`seen`, seen_on_parts) or their part's centre within HAND_PART_NEAR, from DOUBTED_ARM_CONFIDENCE. A hand
+    reported tracked only for hanging off a tracked elbow and wrist (arm_search.hands_at_tracked_wrists) needs
+    it: without, the synthetic hop's hand off a wrongly tracked elbow was reported tracked 15 cm off."""
+    near = np.linalg.norm(props.positions - pos, axis=1) < HAND_PART_NEAR
+    out = np.zeros(20, bool)
+    for s in SIDES:
+        h = J(f"Hand{s}")
+        out[h] = bool(seen[J(f"Wrist{s}")] or (near[h] and props.confidence[h] >= DOUBTED_ARM_CONFIDENCE))
+    return out
+
+
 def disagreeing(pos: np.ndarray, props, frame: np.ndarray | None) -> np.ndarray:
     """(20,) bool: joints left far from a confident proposal of their own part (the fit's evidence and the
-    forest's disagree: not to be reported tracked); a wrist goes with its hand. For the reported states only:
-    the fit's own states carry its history (fed back, this demotion swapped the synthetic hop's hands)."""
+    forest's disagree: not to be reported tracked); an elbow's part counts from DOUBTED_ARM_CONFIDENCE; a wrist
+    goes with its hand. For the reported states only: the fit's own states carry its history (fed back, this
+    demotion swapped the synthetic hop's hands)."""
     p = joint_positions(props, frame)
-    far = (props.confidence >= USE_CONFIDENCE) & (np.linalg.norm(pos - p, axis=1) > DISAGREE)
+    sure = props.confidence >= USE_CONFIDENCE
+    sure[ELBOW_JOINTS] = props.confidence[ELBOW_JOINTS] >= DOUBTED_ARM_CONFIDENCE
+    far = sure & (np.linalg.norm(pos - p, axis=1) > DISAGREE)
     for s in SIDES:
         far[J(f"Wrist{s}")] |= far[J(f"Hand{s}")]
     return far & CHECKED

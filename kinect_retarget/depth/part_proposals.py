@@ -22,6 +22,10 @@ BANDWIDTH = 0.065      # metres, Shotton's mean-shift bandwidth
 SEEDS = 4              # starting points per part (its most likely cells)
 ITERATIONS = 6
 MAX_CELLS = 1500       # classify at most this many cells of a frame (every k-th beyond that)
+TORSO_PARTS = [PART[f"torso_{h}_{s}"] for h in ("upper", "lower") for s in ("left", "right")]
+TORSO_PROB = 0.5       # a cell is the torso's where its four quarters together are this likely
+TORSO_CELLS = 30       # fewer such cells: the forest does not see the torso
+TORSO_FRONT = 0.06     # m: torso cells this much nearer than their median are a forearm held before the chest
 
 
 @dataclass
@@ -60,3 +64,16 @@ def propose(forest: PartForest, grid, mask: np.ndarray) -> Proposals:
         pos[j] = s[best] + s[best] / np.linalg.norm(s[best]) * DEPTH_INSIDE[kind]
         conf[j] = float(k[best].sum())
     return Proposals(pos, conf, (rows, cols), probs)
+
+
+def torso_seen(props: Proposals, xyz: np.ndarray) -> np.ndarray | None:
+    """Where the forest sees the torso: the median of the cells likely to be one of its quarters, leaving out
+    those well before the rest (an arm folded across the chest that the forest takes for torso). `xyz`: the
+    grid's camera-space points. None when too few cells are the torso's."""
+    sel = props.probs[:, TORSO_PARTS].sum(axis=1) > TORSO_PROB
+    if sel.sum() < TORSO_CELLS:
+        return None
+    rows, cols = props.cells
+    pts = xyz[rows[sel], cols[sel]]
+    pts = pts[pts[:, 2] > np.median(pts[:, 2]) - TORSO_FRONT]
+    return np.median(pts, axis=0)

@@ -1,14 +1,14 @@
 """Fit the 20-joint Kinect v1 skeleton to one segmented person (numpy only).
 
-Per frame: a torso patch (geodesic disc around the previous spine) gives the torso frame, the chest's
-surface normals its facing (facing.py); geodesic extrema give head, hand and foot candidates; level-set
-centroids (paper 003) near each extremity give hand/wrist and foot/ankle; elbows and knees come from
-two-bone inverse kinematics with the calibrated bone lengths, choosing on the IK circle the point that best
-agrees with the depth image (projective check), the level-set centroid and the previous frame. An
-extremity at the image's edge or beside a nearer surface is where the view of the limb ends (limb_ends).
-Arms are then fitted against the depth (arm_search): the elbow of a tracked hand, and the whole of an arm
-whose hand is not a tracked extremity. Legs without evidence keep their previous pose relative to the
-torso; both are reported inferred.
+Per frame: a torso patch (geodesic disc around where the forest sees the torso, else the last spine) gives
+the torso frame, the chest's surface normals its facing (facing.py); geodesic extrema give head, hand and
+foot candidates; level-set centroids (paper 003) near each extremity give hand/wrist and foot/ankle; elbows
+and knees come from two-bone inverse kinematics with the calibrated bone lengths, choosing on the IK circle
+the point that best agrees with the depth image (projective check), the level-set centroid and the previous
+frame. An extremity at the image's edge or beside a nearer surface is where the view of the limb ends
+(limb_ends). Arms are then fitted against the depth (arm_search): the elbow of a tracked hand, and the whole
+of an arm whose hand is not a tracked extremity. Legs without evidence keep their previous pose relative to
+the torso; both are reported inferred.
 """
 from __future__ import annotations
 
@@ -23,6 +23,7 @@ from .facing import chest_facing
 from .surface_geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
 from .limb_fit import LimbScene, _nearest_cell, fit_limb
 from .part_fit import USE_CONFIDENCE, shoulders_on_parts
+from .part_proposals import torso_seen
 from .sides import assign_sides
 from .two_bone import unit as _unit
 
@@ -59,6 +60,7 @@ class FitResult:
     edge_on: bool = False                          # the chest's normal was unusable (seen side-on)
     turned: bool = False                           # facing more than TURNED_DEG away from the sensor
     axis: np.ndarray | None = None                 # the torso's up axis (with `lateral`, the body's frame)
+    patch_centre: np.ndarray | None = None         # the torso patch's median before the head top pinned it
 
 
 class Projector:
@@ -115,7 +117,11 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
     graph = SurfaceGraph(xyz, mask, max_jump=0.06)
     proj = Projector(grid, (r0, c0), xyz, mask)
     H = calib.height
-    torso = _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, prev_centre)
+    # the torso's disc grows from where the forest sees the torso now, else from where it was (after a deep
+    # bend the last place is the trunk's lower half, from which the disc did not climb back up)
+    seen = None if proposals is None else torso_seen(proposals, grid.xyz)
+    torso = _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral,
+                         prev_centre if seen is None else seen)
     if torso is None:
         return None
     d0, loose, centre, axis, lat, facing, view, edge_on, narrow = torso
@@ -127,6 +133,7 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
         p = xyz[r, c]
         cand.append(((r, c), p, dist, (p - centre) @ axis, (p - centre) @ lat))
     head_part = confident_head_part(proposals)
+    patch_centre = centre.copy()   # what the calibration measures (the pinned torso sits where the head says)
     head, shift, centre, axis, lat, facing = _pin_along_axis(xyz, mask, cand, centre, axis, lat, facing, up, calib,
                                                              head_part)
 
@@ -187,16 +194,16 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
     if turned:
         for name in ("ShoulderLeft", "ShoulderRight", "HipLeft", "HipRight"):
             st[J[name]] = INFERRED
-    return FitResult(pos, st, lat, labels, centre, proj, edge_on or narrow, turned, axis)
+    return FitResult(pos, st, lat, labels, centre, proj, edge_on or narrow, turned, axis, patch_centre)
 
 
-def _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, prev_centre):
-    """The torso: a geodesic disc around the last spine (or the person's middle) gives its centre and long
+def _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, seed_at):
+    """The torso: a geodesic disc around `seed_at` (or the person's middle) gives its centre and long
     axis; the chest's normals its facing, kept through side-on views. None when the person has no torso.
     Returns (d0 geodesic distances from the seed, the graph that reached every part, centre, axis, lat,
     facing, view, edge_on, narrow)."""
     H = calib.height
-    seed_p = prev_centre if prev_centre is not None else grid.xyz[mask_full].mean(axis=0)
+    seed_p = seed_at if seed_at is not None else grid.xyz[mask_full].mean(axis=0)
     seed = _nearest_cell(xyz, mask, seed_p)
     if seed is None:
         return None
@@ -277,7 +284,9 @@ def _pin_along_axis(xyz, mask, cand, centre, axis, lat, facing, up, calib, head_
                 lat = _unit(lat - (lat @ axis) * axis)
                 facing = _unit(np.cross(lat, axis))
         confirmed = head_part is not None and np.linalg.norm(head[1] - head_part) < HEAD_PART_NEAR
-        if abs(shift) > 0.15 and not (confirmed and FAR_HEAD_SHIFT < shift < MAX_HEAD_SHIFT):
+        # uncalibrated, where the head top sits above the patch is a guess (a default height and proportion)
+        believed = confirmed and (not calib.frames or FAR_HEAD_SHIFT < shift < MAX_HEAD_SHIFT)
+        if abs(shift) > 0.15 and not believed:
             head, shift = None, None   # not the head (a shoulder or raised hand): the torso cannot move that far
     else:
         shift = None

@@ -21,9 +21,10 @@ from .arm_reach import ArmSpeedGate, fold_overreaching_hands
 from .arm_search import hands_at_tracked_wrists
 from .body_model_fit import BodyCalibration
 from .depth_camera import DepthCamera
+from .limb_ends import BORDER_CELLS
 from .confidence import ConfidenceCheck
 from .output_smoothing import OutputSmoothing
-from .part_fit import apply_proposals, body_frame, disagreeing, ends_seen, seen_on_parts
+from .part_fit import apply_proposals, body_frame, disagreeing, ends_seen, hands_backed, seen_on_parts
 from .part_forest import MODEL_PATH, load_forest
 from .part_proposals import propose
 from .sdk_joints import to_sdk_joints
@@ -32,9 +33,8 @@ from .skeleton_fit import HEAD_PART_NEAR, FitResult, confident_head_part, fit_pe
 from .take_smoothing import smooth_recorded_joints
 
 LOST_RESET_S = 0.5   # forget the previous pose after this long without the person (then re-acquire)
-CALIBRATION_FRAMES = 15    # with a floor: standing measurements blended into the height
 CALIBRATION_MEMORY = 300   # standing measurements kept for the height
-STANDING_PATCH = 0.53      # torso patch above the feet, fraction of the height, below which one is not standing
+STANDING_PATCH = 0.53      # torso patch above the feet, fraction of the height so far, below which one is seated
 HANDS_AT_TRACKED_WRISTS = True   # a hand off a tracked elbow and wrist, on the surface seen there, is tracked
 
 
@@ -138,7 +138,9 @@ class SkeletonTracker:
         report = fit.states.copy()   # what is reported; the fit's history keeps its own states
         report[seen] = TRACKED
         if HANDS_AT_TRACKED_WRISTS:
-            report[hands_at_tracked_wrists(fit.positions, report, fit.projector)] = TRACKED
+            # with a forest, a hand hanging off a tracked wrist also needs its own evidence
+            backed = None if self.forest is None else hands_backed(fit.positions, self.last_proposals, seen)
+            report[hands_at_tracked_wrists(fit.positions, report, fit.projector, backed)] = TRACKED
         pos, st = fit.positions, self.confidence.assess(fit.positions, report, fit, own, ends, seen)
         if self.forest is not None:   # reported states only (the fit's history keeps its own)
             doubt |= disagreeing(pos, self.last_proposals, frame)
@@ -180,16 +182,16 @@ class SkeletonTracker:
         return max(tall, key=lambda p: p.pixels / (1.0 + abs(p.centroid[0]) / max(p.centroid[2], 0.5)))
 
     def _calibrate(self, person: PersonMask, fit: FitResult, up: np.ndarray) -> None:
-        """Measure standing height where the head and both feet are seen, both feet down. With no floor in view
-        (pre-segmented frames, a sensor that does not see the floor) heights are taken above the person's
-        lowest point; every pose but standing upright is shorter (seated, crouched, bowing, sitting down), and
-        the lowest point is less sure than a floor, so the height is a high percentile of all measurements. A
-        head extremity far from a confident head part is hands held over the head, not a height."""
-        if self.floor is not None and self.calibration.frames >= CALIBRATION_FRAMES:
-            return   # the floor's own height is sure: the first frames standing on it are enough
+        """Measure standing height where the head and both feet are seen, both feet down, on the floor or, with
+        no floor in view (pre-segmented frames, a sensor that does not see the floor), above the person's lowest
+        point. Every pose but standing upright is shorter (seated, crouched, bowing, sitting down), so the
+        height is a high percentile of all measurements, and the torso patch's place their median near that
+        height. A head extremity far from a confident head part is hands held over the head, not a height."""
         labels = {k: p for k, p in fit.extrema}
         if not {"head", "FootLeft", "FootRight"} <= set(labels):
             return
+        if person.mask[-1 - BORDER_CELLS:].any():
+            return   # cut off by the image's bottom edge: the lowest point seen is no foot, the height no height
         head_part = confident_head_part(self.last_proposals if self.forest is not None else None)
         if head_part is not None and np.linalg.norm(labels["head"] - head_part) > HEAD_PART_NEAR:
             return   # hands held over the head (a basketball shot) measured as the head: 1.81 m for 1.69
@@ -202,14 +204,15 @@ class SkeletonTracker:
         feet_h = [height(labels[k]) for k in ("FootLeft", "FootRight")]
         near_head = pts[np.linalg.norm(pts - labels["head"], axis=1) < 0.2]
         top = float(np.max(height(near_head))) if len(near_head) else float(height(labels["head"]))
-        patch = float(height(fit.torso_centre))
+        # the torso patch where it grew, not where the head top pinned it: the calibration sets where the head
+        # top is expected, which the pin then follows
+        patch = float(height(fit.torso_centre if fit.patch_centre is None else fit.patch_centre))
         if max(feet_h) > 0.15 or not 1.2 < top < 2.2:  # not standing on the floor
             return
-        if self.floor is not None:
-            self.calibration.update(top, patch)
+        if patch < STANDING_PATCH * self.calibration.height:
+            # seated: the torso sits low above the feet for the height so far (not for this frame's head top:
+            # a patch grown from the forest's torso sits as high on a seated trunk as on a standing one)
             return
-        if patch < STANDING_PATCH * top:
-            return  # seated: the torso sits low between the head and the feet
         self._heights = (self._heights + [(top, patch)])[-CALIBRATION_MEMORY:]
         tops = np.array([h for h, _ in self._heights])
         c = self.calibration

@@ -293,23 +293,24 @@ def test_a_knee_between_a_seen_foot_and_its_confident_part_is_seen(no_offsets):
 
 
 def test_a_tracked_joint_moved_past_agreement_is_not_seen(no_offsets):
-    """The fit tracked the left elbow; its part lies 12 cm away (beyond AGREE): the proposal moves it, the fit
-    and the forest disagree, and it is not reported seen. Had the fit doubted it, the move would count."""
+    """The fit tracked the left knee; its part lies 12 cm away (beyond AGREE): the proposal moves it, the fit
+    and the forest disagree, and it is not reported seen. Had the fit doubted it, the move would count (not
+    for an elbow, held to ELBOW_AGREE either way: test below)."""
     pos, st = _standing_pose()
     props = _proposals(pos)
-    props.positions[j("ElbowLeft")] += [0.0, 0.12, 0.0]
+    props.positions[j("KneeLeft")] += [-0.12, 0.0, 0.0]
     before, before_st = pos.copy(), st.copy()
     _, own = part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
-    assert np.allclose(pos[j("ElbowLeft")], props.positions[j("ElbowLeft")])
-    assert not part_fit.seen_on_parts(before, pos, props, FACING, own, False, before_st)[j("ElbowLeft")]
+    assert np.allclose(pos[j("KneeLeft")], props.positions[j("KneeLeft")]) and st[j("KneeLeft")] == INFERRED
+    assert not part_fit.seen_on_parts(before, pos, props, FACING, own, False, before_st)[j("KneeLeft")]
     doubted = before_st.copy()
-    doubted[j("ElbowLeft")] = INFERRED
-    assert part_fit.seen_on_parts(before, pos, props, FACING, own, False, doubted)[j("ElbowLeft")]
+    doubted[j("KneeLeft")] = INFERRED
+    assert part_fit.seen_on_parts(before, pos, props, FACING, own, False, doubted)[j("KneeLeft")]
 
 
 def test_a_shoulder_or_head_moved_onto_its_part_is_seen_however_far(no_offsets):
     """The forest's torso-top parts are its surest: a tracked shoulder or head its part moves 20 cm is seen
-    on it (an elbow moved as far is not: test above)."""
+    on it (a tracked knee or elbow moved as far is not: tests above)."""
     pos, st = _standing_pose()
     pos[j("Head")] = [0.0, 0.7, 2.5]
     props = _proposals(pos)
@@ -363,3 +364,47 @@ def test_shoulders_move_onto_confident_parts_before_the_arms_and_nothing_else(no
     again = before.copy()
     part_fit.shoulders_on_parts(again, st, unsure, np.array([-1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
     assert np.array_equal(again, before)
+
+
+def test_elbows_are_held_to_closer_agreement_than_other_joints(no_offsets):
+    """An elbow is the least sure of the seen parts: a tracked elbow its part moves 9.5 cm is demoted (a hand
+    moved as far keeps its state), a doubted elbow moved 12 cm onto its part is not seen there (a knee moved as
+    far is), and an elbow 20 cm from a part only DOUBTED_ARM_CONFIDENCE sure is doubted (a hand is not)."""
+    pos, st = _standing_pose()
+    props = _proposals(pos)
+    props.positions[j("ElbowLeft")] += [0.0, 0.095, 0.0]
+    props.positions[j("HandRight")] += [0.0, 0.095, 0.0]
+    part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    assert st[j("ElbowLeft")] == INFERRED and st[j("HandRight")] == TRACKED
+
+    pos, st = _standing_pose()
+    st[[j("ElbowLeft"), j("KneeLeft")]] = INFERRED
+    props = _proposals(pos)
+    props.positions[j("ElbowLeft")] += [0.0, 0.12, 0.0]
+    props.positions[j("KneeLeft")] += [0.0, 0.12, 0.0]
+    before = pos.copy()
+    _, own = part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
+    assert np.allclose(pos[j("ElbowLeft")], props.positions[j("ElbowLeft")])
+    seen = part_fit.seen_on_parts(before, pos, props, FACING, own, turned=False)
+    assert seen[j("KneeLeft")] and not seen[j("ElbowLeft")]
+
+    pos, _ = _standing_pose()
+    props = _proposals(pos, conf=(part_fit.DOUBTED_ARM_CONFIDENCE + part_fit.USE_CONFIDENCE) / 2)
+    props.positions[j("ElbowLeft")] += [0.0, 0.2, 0.0]
+    props.positions[j("HandRight")] += [0.0, 0.2, 0.0]
+    assert set(np.flatnonzero(part_fit.disagreeing(pos, props, FACING))) == {j("ElbowLeft")}
+    props.confidence[:] = part_fit.DOUBTED_ARM_CONFIDENCE / 2   # too weak even for an elbow
+    assert not part_fit.disagreeing(pos, props, FACING).any()
+
+
+def test_a_hand_is_backed_by_its_seen_wrist_or_its_own_part_nearby():
+    pos, _ = _standing_pose()
+    props = _proposals(pos, conf=part_fit.DOUBTED_ARM_CONFIDENCE)
+    props.positions[j("HandLeft")] += [0.0, 0.2, 0.0]      # the left hand's part 20 cm away
+    seen = np.zeros(20, bool)
+    backed = part_fit.hands_backed(pos, props, seen)
+    assert set(np.flatnonzero(backed)) == {j("HandRight")}
+    seen[j("WristLeft")] = True                             # ... but its wrist is seen on its own part
+    assert part_fit.hands_backed(pos, props, seen)[j("HandLeft")]
+    props.confidence[j("HandRight")] = part_fit.DOUBTED_ARM_CONFIDENCE / 2   # a part too weak to back it
+    assert not part_fit.hands_backed(pos, props, seen)[j("HandRight")]

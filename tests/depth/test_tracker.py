@@ -153,3 +153,37 @@ def test_a_head_extremity_away_from_the_head_part_is_not_measured(rendered, monk
 
     assert heights([0.0, 0.0, 0.0]) > 0
     assert heights([0.0, -0.4, 0.0]) == 0   # the head part 40 cm below the extremity: not measured
+
+
+def test_calibration_measures_the_torso_patch_where_it_grew_not_where_the_head_pinned_it(rendered, monkeypatch):
+    """The calibration's torso-patch height says where the pin expects the head top; measured on the pinned
+    torso it would follow the pin's own moves (on real depth, a torso seeded where the forest sees it lost
+    subject 4's head that way). A pin moved 10 cm up leaves the measured patch height as it was."""
+    from kinect_retarget.core.conventions import depth_pixel_to_kinect
+    from kinect_retarget.depth import skeleton_fit
+    seq, _ = rendered
+    cam = SkeletonTracker().camera
+    v, u = np.mgrid[0:480, 0:640]
+    mm = seq.mm.copy()
+    for f in mm:   # pre-segmented (no floor): every standing frame is measured
+        xyz = depth_pixel_to_kinect(u, v, f * 0.001, cam.f, cam.cx, cam.cy)
+        f[((xyz @ -seq.gravity) < -0.88) | (xyz[..., 2] > 4.4)] = 0
+
+    def patch_height():
+        tracker = SkeletonTracker()
+        for f, t in zip(mm, seq.times):
+            tracker.update(f, t)
+        assert tracker.calibration.frames > 0
+        return tracker.calibration.torso_patch_height
+
+    grown = patch_height()
+    real = skeleton_fit._pin_along_axis
+
+    def pinned_higher(*args, **kwargs):
+        head, shift, centre, axis, lat, facing = real(*args, **kwargs)
+        return head, shift, centre + 0.1 * axis, axis, lat, facing
+
+    monkeypatch.setattr(skeleton_fit, "_pin_along_axis", pinned_higher)
+    assert abs(patch_height() - grown) < 0.01
+    monkeypatch.setattr(skeleton_fit, "_pin_along_axis", real)
+    assert 0.5 < grown < 0.75, grown
