@@ -83,6 +83,10 @@ ELBOW_JOINTS = [J(f"Elbow{s}") for s in SIDES]
 # DOUBTED_ARM_CONFIDENCE (disagreeing). With the torso seeded where the forest sees it (part_proposals), the
 # synthetic hop's elbows sat on the edge of 15 cm tracked-but-wrong at AGREE and USE_CONFIDENCE
 ELBOW_AGREE = 0.09
+# a sure hand (USE_CONFIDENCE) beyond this many elbow-to-hand lengths from an elbow without a sure part of its
+# own: the elbow is solved between shoulder and hand (on real depth the fit lost an arm pushed forward to a
+# hanging pose, its elbow took a weak part on the trunk 60 cm from the hand, and the hand was folded back)
+ELBOW_HAND_MAX = 1.3
 # joints whose proposals check the fit's states (not hips, knees or spine: the fit's states stand for those)
 CHECKED = np.array([not n.startswith(("Hip", "Knee", "Spine")) for n in KINECT_V1.joints])
 OUTWARD = np.array([1.0 if "Left" in n else -1.0 if "Right" in n else 0.0 for n in KINECT_V1.joints])
@@ -196,6 +200,12 @@ def _arm_direct(pos, st, p, conf, use, s, height) -> None:
         if (np.linalg.norm(pos[ha] - pos[el]) < FOREARM_MIN * reach
                 and _in_elbow_reach(pos[el], pos[J(f"Shoulder{s}")], height)):
             pos[ha] = pos[el] + _unit(pos[ha] - pos[el]) * reach
+        if (conf[ha] >= USE_CONFIDENCE and not (use[el] and conf[el] >= USE_CONFIDENCE)
+                and np.linalg.norm(pos[ha] - pos[el]) > ELBOW_HAND_MAX * reach):
+            # the forearm is rigid: the elbow on its circle between shoulder and hand, nearest where it was
+            cands, _ = two_bone_candidates(pos[J(f"Shoulder{s}")], pos[ha], bm.UPPER_ARM * height, reach)
+            pos[el] = cands[int(np.argmin(np.linalg.norm(cands - pos[el], axis=1)))]
+            st[el] = INFERRED
         pos[wr] = pos[ha] - _unit(pos[ha] - pos[el]) * WRIST_BEFORE_HAND * height
         st[wr] = _state(min(conf[el], conf[ha]))
 

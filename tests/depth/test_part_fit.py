@@ -229,10 +229,12 @@ def test_an_elbow_proposal_at_its_own_hand_is_refused(no_offsets):
     st[[j("ElbowRight"), j("WristRight"), j("HandRight")]] = INFERRED   # the fit lost the raised arm
     props.positions[j("HandRight")] = [0.1, 0.55, 2.4]       # the right hand raised to the face
     props.positions[j("ElbowRight")] = [0.12, 0.5, 2.4]      # a hand part taken for the elbow, beside it
-    before = pos.copy()
     part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
     assert np.allclose(pos[j("HandRight")], [0.1, 0.55, 2.4])
-    assert np.allclose(pos[j("ElbowRight")], before[j("ElbowRight")])
+    # not the hand part: the fit's hanging elbow, out of the forearm's reach of the sure hand, solved between
+    # shoulder and hand instead
+    assert np.linalg.norm(pos[j("ElbowRight")] - props.positions[j("ElbowRight")]) > 0.1
+    assert np.isclose(np.linalg.norm(pos[j("HandRight")] - pos[j("ElbowRight")]), part_fit.ELBOW_TO_HAND * 1.7)
     props.positions[j("ElbowRight")] = [0.3, 0.25, 2.4]      # an elbow a forearm away from that hand is taken
     part_fit.apply_proposals(pos, st, props, 1.7, frame=FACING)
     assert np.allclose(pos[j("ElbowRight")], [0.3, 0.25, 2.4])
@@ -408,3 +410,35 @@ def test_a_hand_is_backed_by_its_seen_wrist_or_its_own_part_nearby():
     assert part_fit.hands_backed(pos, props, seen)[j("HandLeft")]
     props.confidence[j("HandRight")] = part_fit.DOUBTED_ARM_CONFIDENCE / 2   # a part too weak to back it
     assert not part_fit.hands_backed(pos, props, seen)[j("HandRight")]
+
+
+def test_an_elbow_out_of_its_forearm_reach_of_a_sure_hand_is_solved_between_shoulder_and_hand(no_offsets,
+                                                                                               monkeypatch):
+    """The left arm pushed 50 cm forward: the forest sees the hand surely, the fit had the arm hanging and the
+    elbow's only part is a weak one on the trunk, 62 cm from the hand. The forearm is rigid: the elbow goes on
+    its circle between shoulder and hand. An elbow whose own part is sure stays on it."""
+    pos, st = _standing_pose()
+    st[[j("ElbowLeft"), j("WristLeft"), j("HandLeft")]] = INFERRED
+    props = _proposals(pos, conf=part_fit.USE_CONFIDENCE)
+    props.positions[j("HandLeft")] = [-0.17, 0.3, 2.0]
+    props.positions[j("ElbowLeft")] = [-0.17, 0.15, 2.6]
+    props.confidence[j("ElbowLeft")] = part_fit.DOUBTED_ARM_CONFIDENCE
+    h = 1.7
+    reach, upper = part_fit.ELBOW_TO_HAND * h, part_fit.bm.UPPER_ARM * h
+    solved_pos, solved_st = pos.copy(), st.copy()
+    part_fit.apply_proposals(solved_pos, solved_st, props, h, frame=FACING)
+    hand, elbow, shoulder = (solved_pos[j(f"{n}Left")] for n in ("Hand", "Elbow", "Shoulder"))
+    assert np.allclose(hand, props.positions[j("HandLeft")])
+    assert np.isclose(np.linalg.norm(hand - elbow), reach) and np.isclose(np.linalg.norm(elbow - shoulder), upper)
+    assert solved_st[j("ElbowLeft")] == INFERRED
+
+    sure = props.confidence.copy()
+    props.confidence[j("ElbowLeft")] = part_fit.USE_CONFIDENCE   # the elbow's own part is sure: kept
+    kept = pos.copy()
+    part_fit.apply_proposals(kept, st.copy(), props, h, frame=FACING)
+    assert np.allclose(kept[j("ElbowLeft")], props.positions[j("ElbowLeft")])
+    props.confidence[:] = sure
+    monkeypatch.setattr(part_fit, "ELBOW_HAND_MAX", np.inf)   # the rule off: the weak trunk part is taken
+    off = pos.copy()
+    part_fit.apply_proposals(off, st.copy(), props, h, frame=FACING)
+    assert np.allclose(off[j("ElbowLeft")], props.positions[j("ElbowLeft")])
