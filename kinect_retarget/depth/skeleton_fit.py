@@ -258,8 +258,10 @@ def _pin_along_axis(xyz, mask, cand, centre, axis, lat, facing, up, calib, head_
     """Where the torso sits along its axis: the head top (which may also tilt a leaning trunk) and, better,
     the tops of the shoulders. A head top farther along the axis than the torso may move in a frame is
     refused, except FAR_HEAD_SHIFT-MAX_HEAD_SHIFT *up* the axis where the forest's confident head part
-    (`head_part`) confirms it: the torso's disc, seeded at its last place, cannot climb back up on its own
-    after a deep bend. Returns (head candidate or None, shift or None, centre, axis, lat, facing)."""
+    (`head_part`) confirms it: the torso's disc, seeded at its last place where the forest does not see the
+    torso, cannot climb back up on its own after a deep bend; and anywhere before the height is calibrated
+    (the head top's place above the disc is then a guess). Returns (head candidate or None, shift or None,
+    centre, axis, lat, facing)."""
     H = calib.height
     heady = [e for e in cand if (e[1] - centre) @ up > 0 and abs(e[4]) < 0.15 * H]
     head = max(heady, key=lambda e: e[1] @ up, default=None)

@@ -206,7 +206,7 @@ class SkeletonTracker:
         top = float(np.max(height(near_head))) if len(near_head) else float(height(labels["head"]))
         # the torso patch where it grew, not where the head top pinned it: the calibration sets where the head
         # top is expected, which the pin then follows
-        patch = float(height(fit.torso_centre if fit.patch_centre is None else fit.patch_centre))
+        patch = float(height(fit.patch_centre))
         if max(feet_h) > 0.15 or not 1.2 < top < 2.2:  # not standing on the floor
             return
         if patch < STANDING_PATCH * self.calibration.height:
