@@ -53,6 +53,8 @@ INSIDE_COST = 2.0      # an elbow or hand inside the torso
 TORSO_HALF_WIDTH = 0.1   # fraction of height: the trunk's half width seen from the front
 IN_FRONT = 0.06        # m in front of the chest's surface: an arm, not the chest
 TORSO_BAND = 0.04      # fraction of height: bands of the trunk whose surface depth is taken apart
+# the trunk's surface: bands nearer than the line through all bands are set back to it (see torso())
+SURFACE_LINE = True
 HEAD_HALF_WIDTH = 0.065  # fraction of height: head and neck, above the shoulder line
 LEG_RADIUS = 0.09      # m around the fitted leg bones
 ARM_UNSEEN_COST = 0.1      # per-sample search cost above which no arm was seen (hidden: keep the carried pose)
@@ -90,21 +92,38 @@ class TorsoFrame:
     def torso(self, pts, mask, half_width=TORSO_HALF_WIDTH, front=IN_FRONT):
         """Cells of the trunk: within its width between hips and shoulders, and not standing out in front of
         its surface. The surface's depth is the median of each height band, so a forward lean or a bent
-        back does not make the upper chest look like an arm in front of it."""
+        back does not make the upper chest look like an arm in front of it; but no band is nearer than the
+        line through the bands' medians: forearms folded over the chest fill their bands, whose medians
+        then lie on the forearms, and the arms went unexplained (on real depth, crossed arms 14.7 -> 11.8
+        degrees against the Kinect SDK, docs/depth_tracking.md)."""
         a, l, f = self.coords(pts)
         box = mask & (a > self.hip_a - 0.03 * self.H) & (a < self.shoulder_a + 0.03 * self.H) \
             & (np.abs(l) < half_width * self.H)
         band = np.floor((a - self.hip_a) / (TORSO_BAND * self.H)).astype(np.int64)
         surface = np.zeros_like(f)
-        for b in np.unique(band[box]):
-            sel = box & (band == b)
-            surface[sel] = np.median(f[sel])
+        bands = np.unique(band[box])
+        level = np.array([np.median(f[box & (band == b)]) for b in bands])
+        if SURFACE_LINE:
+            level = _no_nearer_than_line(bands, level)
+        for b, v in zip(bands, level):
+            surface[box & (band == b)] = v
         return box & (f < surface + front)
 
     def inside(self, pts):
         """Points well inside the trunk (behind its front surface, within its width)."""
         a, l, f = self.coords(pts)
         return (a > self.hip_a) & (a < self.shoulder_a) & (np.abs(l) < 0.08 * self.H) & (f < -0.03) & (f > -0.25)
+
+
+def _no_nearer_than_line(bands: np.ndarray, level: np.ndarray) -> np.ndarray:
+    """Band surface depths (`level`, larger = nearer the sensor) no nearer than the robust line through them
+    (Theil-Sen over the band indices, so a lean or a bent back still tilts it). Fewer than 4 bands: as given."""
+    if len(bands) < 4:
+        return level
+    i, j = np.triu_indices(len(bands), 1)
+    slope = np.median((level[j] - level[i]) / (bands[j] - bands[i]))
+    line = np.median(level - slope * bands) + slope * bands
+    return np.minimum(level, line)
 
 
 def arm_evidence(xyz: np.ndarray, mask: np.ndarray, pos: np.ndarray, frame: TorsoFrame,

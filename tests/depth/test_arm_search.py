@@ -181,3 +181,40 @@ def test_hanging_hands_below_tracked_wrists_are_tracked(data_dir, monkeypatch):
     monkeypatch.setattr(skeleton_tracker, "HANDS_AT_TRACKED_WRISTS", False)
     without = tracked_hand_errors()
     assert len(with_rule) >= len(without) + 8 and max(with_rule) < 0.10
+
+
+def _leaning_trunk_with_folded_forearms():
+    """Cells of a trunk 1.7 m tall seen from the front, leaning back 10 cm from hips to shoulders, with forearms
+    folded across its chest: 8 cm before the surface and as wide as the trunk, so they fill their bands."""
+    H = 1.7
+    frame = arm_search.TorsoFrame(np.zeros(3), np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0]),
+                                  np.array([0.0, 0.0, 1.0]), np.zeros((20, 3)), H)
+    frame.hip_a, frame.shoulder_a = -0.25, 0.25
+    a, l = np.meshgrid(np.linspace(-0.26, 0.26, 53), np.linspace(-0.15, 0.15, 31), indexing="ij")
+    f = -0.2 * a   # the lean: the surface nearer the sensor at the hips
+    forearms = np.isin(np.floor((a + 0.25) / (arm_search.TORSO_BAND * H)), (4, 5))   # two whole bands
+    f = f + np.where(forearms, 0.08, 0.0)
+    pts = np.stack([l, a, f], axis=-1)
+    return frame, pts, forearms
+
+
+def test_forearms_folded_over_the_chest_are_not_taken_for_it(monkeypatch):
+    frame, pts, forearms = _leaning_trunk_with_folded_forearms()
+    mask = np.ones(forearms.shape, bool)
+    torso = frame.torso(pts, mask)
+    assert not torso[forearms].any()            # arm evidence, for the search to explain
+    assert torso[~forearms].mean() > 0.95       # the leaning chest itself is still the trunk
+    # with each band's own median as the surface, the forearms filling their bands were the chest
+    monkeypatch.setattr(arm_search, "SURFACE_LINE", False)
+    assert frame.torso(pts, mask)[forearms].all()
+
+
+def test_band_surfaces_are_set_back_to_their_line_never_forward():
+    bands = np.arange(8)
+    level = 0.3 - 0.01 * bands                  # a lean
+    level[3:5] += 0.07                          # two bands of forearms
+    level[6] -= 0.03                            # a hollow stays where it is
+    out = arm_search._no_nearer_than_line(bands, level)
+    assert np.allclose(out[3:5], 0.3 - 0.01 * bands[3:5])
+    assert np.allclose(np.delete(out, [3, 4]), np.delete(level, [3, 4]))
+    assert np.array_equal(arm_search._no_nearer_than_line(bands[:3], level[:3]), level[:3])
