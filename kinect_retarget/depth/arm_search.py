@@ -100,13 +100,13 @@ class TorsoFrame:
         box = mask & (a > self.hip_a - 0.03 * self.H) & (a < self.shoulder_a + 0.03 * self.H) \
             & (np.abs(l) < half_width * self.H)
         band = np.floor((a - self.hip_a) / (TORSO_BAND * self.H)).astype(np.int64)
-        surface = np.zeros_like(f)
-        bands = np.unique(band[box])
-        level = np.array([np.median(f[box & (band == b)]) for b in bands])
+        bands, which = np.unique(band[box], return_inverse=True)
+        in_box = f[box]
+        level = np.array([np.median(in_box[which == k]) for k in range(len(bands))])
         if SURFACE_LINE:
             level = _no_nearer_than_line(bands, level)
-        for b, v in zip(bands, level):
-            surface[box & (band == b)] = v
+        surface = np.zeros_like(f)
+        surface[box] = level[which]
         return box & (f < surface + front)
 
     def inside(self, pts):
