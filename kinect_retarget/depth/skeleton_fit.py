@@ -1,14 +1,14 @@
 """Fit the 20-joint Kinect v1 skeleton to one segmented person (numpy only).
 
 Per frame: a torso patch (geodesic disc around where the forest sees the torso, else the last spine) gives
-the torso frame, the chest's surface normals its facing (facing.py); geodesic extrema give head, hand and
-foot candidates; level-set centroids (paper 003) near each extremity give hand/wrist and foot/ankle; elbows
-and knees come from two-bone inverse kinematics with the calibrated bone lengths, choosing on the IK circle
-the point that best agrees with the depth image (projective check), the level-set centroid and the previous
-frame. An extremity at the image's edge or beside a nearer surface is where the view of the limb ends
-(limb_ends). Arms are then fitted against the depth (arm_search): the elbow of a tracked hand, and the whole
-of an arm whose hand is not a tracked extremity. Legs without evidence keep their previous pose relative to
-the torso; both are reported inferred.
+the torso frame, the line between the forest's shoulder parts (or else the chest's surface normals, facing.py)
+its facing; geodesic extrema give head, hand and foot candidates; level-set centroids (paper 003) near each
+extremity give hand/wrist and foot/ankle; elbows and knees come from two-bone inverse kinematics with the
+calibrated bone lengths, choosing on the IK circle the point that best agrees with the depth image
+(projective check), the level-set centroid and the previous frame. An extremity at the image's edge or beside
+a nearer surface is where the view of the limb ends (limb_ends). Arms are then fitted against the depth
+(arm_search): the elbow of a tracked hand, and the whole of an arm whose hand is not a tracked extremity.
+Legs without evidence keep their previous pose relative to the torso; both are reported inferred.
 """
 from __future__ import annotations
 
@@ -46,6 +46,13 @@ SIDE_ON_DEG = 75.0          # chest facing this far from the sensor: side-on, th
 TURN_JUMP_FROM_DEG = 15.0   # facing the sensor within this, a turn of ...
 TURN_JUMP_DEG = 25.0        # ... more than this in one frame is not believed ...
 TURN_CREEP_DEG = 3.0        # ... and the left-right direction turns toward it by this much a frame
+# the torso's left-right direction from the line between the forest's shoulder parts: on real depth (UTD-MHAD
+# subjects 1-2) that line's yaw lay 4.6 degrees from the SDK's shoulders (median 2.3), the chest's normals 12.1
+# (7.2): arms held before the chest tilt them, and Kinect v1's depth steps make flat patches whose normals
+# face the sensor (a third of the chest's cells), so a turn of 50 degrees read as none
+SHOULDER_LINE = True
+SHOULDER_LINE_CONFIDENCE = 0.0003   # square metres of likely part around each shoulder's proposal
+SHOULDER_LINE_SPAN = (0.2, 0.55)    # m between the two proposals: a shoulder line, not a confused part
 LATERAL_SMOOTHING = 0.5     # weight of the last frame's left-right direction (the chest's estimate is noisy)
 
 
@@ -121,7 +128,7 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
     # bend the last place is the trunk's lower half, from which the disc did not climb back up)
     seen = None if proposals is None else torso_seen(proposals, grid.xyz)
     torso = _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral,
-                         prev_centre if seen is None else seen)
+                         prev_centre if seen is None else seen, shoulder_line(proposals))
     if torso is None:
         return None
     d0, loose, centre, axis, lat, facing, view, edge_on, narrow = torso
@@ -197,7 +204,31 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
     return FitResult(pos, st, lat, labels, centre, proj, edge_on or narrow, turned, axis, patch_centre)
 
 
-def _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, seed_at):
+def shoulder_line(proposals) -> np.ndarray | None:
+    """Right shoulder -> left shoulder of the forest's shoulder parts, where it sees both and they lie a
+    shoulder width apart; else None."""
+    if not SHOULDER_LINE or proposals is None:
+        return None
+    left, right = J["ShoulderLeft"], J["ShoulderRight"]
+    if min(proposals.confidence[left], proposals.confidence[right]) < SHOULDER_LINE_CONFIDENCE:
+        return None
+    line = proposals.positions[left] - proposals.positions[right]
+    return line if SHOULDER_LINE_SPAN[0] < np.linalg.norm(line) < SHOULDER_LINE_SPAN[1] else None
+
+
+def _line_facing(line: np.ndarray | None, axis: np.ndarray, toward: np.ndarray) -> np.ndarray | None:
+    """The facing (across `axis`) square to a shoulder line, or None without one or where it would face away
+    from the sensor (`toward`): the performer is taken to face it, as with the chest's normals."""
+    if line is None:
+        return None
+    across = line - (line @ axis) * axis
+    if np.linalg.norm(across) < 1e-6:
+        return None
+    facing = _unit(np.cross(across, axis))
+    return facing if facing @ toward > 0 else None
+
+
+def _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, seed_at, line=None):
     """The torso: a geodesic disc around `seed_at` (or the person's middle) gives its centre and long
     axis; the chest's normals its facing, kept through side-on views. None when the person has no torso.
     Returns (d0 geodesic distances from the seed, the graph that reached every part, centre, axis, lat,
@@ -229,7 +260,10 @@ def _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, see
     facing = _unit(facing - (facing @ axis) * axis)
     edge_on = bool(facing @ -view < 0.3)
     toward = _unit(-view - (-view @ axis) * axis)
-    chest = chest_facing(xyz, mask, centre - axis * calib.torso_patch_height * H, axis, H)
+    # the facing read from the shoulders' parts where the forest sees both, else from the chest's normals
+    chest = _line_facing(line, axis, toward)
+    if chest is None:
+        chest = chest_facing(xyz, mask, centre - axis * calib.torso_patch_height * H, axis, H)
     held = prev_lateral is not None and (chest is None or chest @ toward < np.cos(np.radians(SIDE_ON_DEG)))
     if held:  # side-on the chest's direction is ambiguous: keep the last one until the turn goes on
         lat = _unit(prev_lateral - (prev_lateral @ axis) * axis)
