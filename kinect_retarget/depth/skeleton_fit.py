@@ -51,9 +51,10 @@ TURN_CREEP_DEG = 3.0        # ... and the left-right direction turns toward it b
 # (7.2): arms held before the chest tilt them, and Kinect v1's depth steps make flat patches whose normals
 # face the sensor (a third of the chest's cells), so a turn of 50 degrees read as none
 SHOULDER_LINE = True
-SHOULDER_LINE_CONFIDENCE = 0.0003   # square metres of likely part around each shoulder's proposal
+SHOULDER_LINE_CONFIDENCE = USE_CONFIDENCE   # square metres of likely part around each shoulder's proposal
 SHOULDER_LINE_SPAN = (0.2, 0.55)    # m between the two proposals: a shoulder line, not a confused part
-LATERAL_SMOOTHING = 0.5     # weight of the last frame's left-right direction (the chest's estimate is noisy)
+SHOULDER_LINE_MAX_DEG = 90.0
+LATERAL_SMOOTHING = 0.25    # weight of the last frame's left-right direction (0.5 before the shoulder line)
 
 
 @dataclass
@@ -225,7 +226,7 @@ def _line_facing(line: np.ndarray | None, axis: np.ndarray, toward: np.ndarray) 
     if np.linalg.norm(across) < 1e-6:
         return None
     facing = _unit(np.cross(across, axis))
-    return facing if facing @ toward > 0 else None
+    return facing if facing @ toward > np.cos(np.radians(SHOULDER_LINE_MAX_DEG)) else None
 
 
 def _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, seed_at, line=None):

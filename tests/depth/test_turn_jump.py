@@ -1,7 +1,7 @@
 """A facing reading that jumps in one frame is not believed (skeleton_fit.next_lateral)."""
 import numpy as np
 
-from kinect_retarget.depth.skeleton_fit import TURN_CREEP_DEG, next_lateral
+from kinect_retarget.depth.skeleton_fit import LATERAL_SMOOTHING, TURN_CREEP_DEG, next_lateral
 
 AXIS = np.array([0.0, 1.0, 0.0])
 TOWARD = np.array([0.0, 0.0, -1.0])   # from the performer to the sensor
@@ -25,10 +25,12 @@ def test_a_jump_from_facing_only_creeps():
 
 def test_a_gradual_turn_is_followed():
     out = next_lateral(lateral(15.0), lateral(4.0), AXIS, TOWARD)
-    assert 8.0 < turned_deg(out) < 11.0   # blended with the last frame, as before
+    blended = LATERAL_SMOOTHING * 4.0 + (1 - LATERAL_SMOOTHING) * 15.0   # with the last frame, as before
+    assert abs(turned_deg(out) - blended) < 1.0
 
 
 def test_once_turned_a_jump_is_taken():
-    assert abs(turned_deg(next_lateral(lateral(60.0), lateral(30.0), AXIS, TOWARD)) - 45.0) < 1.0
+    blended = LATERAL_SMOOTHING * 30.0 + (1 - LATERAL_SMOOTHING) * 60.0
+    assert abs(turned_deg(next_lateral(lateral(60.0), lateral(30.0), AXIS, TOWARD)) - blended) < 1.0
     mirrored = next_lateral(lateral(-70.0), lateral(70.0), AXIS, TOWARD)   # the mirror image flipping over
     assert abs(turned_deg(mirrored) - 70.0) < 0.5
