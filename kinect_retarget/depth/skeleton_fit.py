@@ -49,11 +49,10 @@ TURN_CREEP_DEG = 3.0        # ... and the left-right direction turns toward it b
 # the torso's left-right direction from the line between the forest's shoulder parts: on real depth (UTD-MHAD
 # subjects 1-2) that line's yaw lay 4.6 degrees from the SDK's shoulders (median 2.3), the chest's normals 12.1
 # (7.2): arms held before the chest tilt them, and Kinect v1's depth steps make flat patches whose normals
-# face the sensor (a third of the chest's cells), so a turn of 50 degrees read as none
+# face the sensor (a fifth to two fifths of a turned chest's cells), so turns of 52-72 degrees read as none
 SHOULDER_LINE = True
 SHOULDER_LINE_CONFIDENCE = USE_CONFIDENCE   # square metres of likely part around each shoulder's proposal
 SHOULDER_LINE_SPAN = (0.2, 0.55)    # m between the two proposals: a shoulder line, not a confused part
-SHOULDER_LINE_MAX_DEG = 90.0
 LATERAL_SMOOTHING = 0.25    # weight of the last frame's left-right direction (0.5 before the shoulder line)
 
 
@@ -226,12 +225,13 @@ def _line_facing(line: np.ndarray | None, axis: np.ndarray, toward: np.ndarray) 
     if np.linalg.norm(across) < 1e-6:
         return None
     facing = _unit(np.cross(across, axis))
-    return facing if facing @ toward > np.cos(np.radians(SHOULDER_LINE_MAX_DEG)) else None
+    return facing if facing @ toward > 0 else None
 
 
 def _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, seed_at, line=None):
     """The torso: a geodesic disc around `seed_at` (or the person's middle) gives its centre and long
-    axis; the chest's normals its facing, kept through side-on views. None when the person has no torso.
+    axis; the shoulder `line` (shoulder_line) or else the chest's normals its facing, kept through side-on
+    views. None when the person has no torso.
     Returns (d0 geodesic distances from the seed, the graph that reached every part, centre, axis, lat,
     facing, view, edge_on, narrow)."""
     H = calib.height
