@@ -221,10 +221,10 @@ def _line_facing(line: np.ndarray | None, axis: np.ndarray, toward: np.ndarray) 
     from the sensor (`toward`): the performer is taken to face it, as with the chest's normals."""
     if line is None:
         return None
-    across = line - (line @ axis) * axis
-    if np.linalg.norm(across) < 1e-6:
+    square = np.cross(line, axis)   # across the axis, whatever the line's tilt along it
+    if np.linalg.norm(square) < 1e-6:
         return None
-    facing = _unit(np.cross(across, axis))
+    facing = _unit(square)
     return facing if facing @ toward > 0 else None
 
 
