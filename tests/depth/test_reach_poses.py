@@ -7,7 +7,7 @@ import pytest
 from kinect_retarget.assets import MAKEHUMAN_DIR
 from kinect_retarget.sim.makehuman_body import load_body
 from kinect_retarget.sim.mocap_pose import _rest_points
-from kinect_retarget.sim.reach_poses import TARGETS, body_axes, reach_arm, reach_target, reaching
+from kinect_retarget.sim.reach_poses import TARGETS, body_axes, gripping, reach_arm, reach_target, reaching
 
 BONES = [("shoulder", "elbow"), ("elbow", "wrist"), ("wrist", "hand")]
 
@@ -63,3 +63,23 @@ def test_targets_lie_on_and_around_the_body(rest):
     across = np.mean(pts @ lat < 0)   # the left hand over the right half of the body (crossed arms)
     assert 0.1 < across < 0.6
     assert len(TARGETS) == 7
+
+
+def test_gripping_puts_both_hands_together_before_the_body(rest):
+    lat, up, fwd = body_axes(rest)
+    hand = np.linalg.norm(rest["hand.L"] - rest["wrist.L"])
+    apart, crossed = [], 0
+    for k in range(60):
+        p = gripping(rest, np.random.default_rng([7, k]))
+        for s in ("L", "R"):
+            for a, b in BONES:
+                assert np.linalg.norm(p[f"{b}.{s}"] - p[f"{a}.{s}"]) == pytest.approx(
+                    np.linalg.norm(rest[f"{b}.{s}"] - rest[f"{a}.{s}"]), rel=1e-9)
+            assert (p[f"hand.{s}"] - rest["chest"]) @ fwd > -0.1   # before the body (overhead: about over it)
+        assert all(np.array_equal(p[n], rest[n]) for n in ("hips", "neck", "head", "hip.L", "knee.R"))
+        apart.append(np.linalg.norm(p["hand.L"] - p["hand.R"]))
+        crossed += (p["hand.L"] - rest["chest"]) @ lat < 0   # the left hand over the right half of the body
+    assert np.median(apart) < 1.5 * hand and max(apart) < 3.0 * hand   # one thing held in both hands
+    assert 10 < crossed < 50   # at the right shoulder (a bat), the left arm crosses the chest; at the left, not
+    a, b = gripping(rest, np.random.default_rng(4)), gripping(rest, np.random.default_rng(4))
+    assert all(np.array_equal(a[n], b[n]) for n in a)
