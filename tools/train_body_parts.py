@@ -309,7 +309,7 @@ def make_data(args):
             print(f"  {min((k + 1) * CHUNK, total)}/{total} images, {time.perf_counter() - t0:.0f} s", flush=True)
     if pool:
         pool.close()
-    if skirted is not None:
+    if left_out:   # (chunks cached before skirted images were skipped while rendering still hold them)
         print(f"  leaving out the {left_out} samples of skirted performers' images", flush=True)
     x = np.empty((sum(len(v) for v in xs), xs[0].shape[1]), np.float32)
     at = 0
