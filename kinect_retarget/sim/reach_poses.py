@@ -108,7 +108,7 @@ def reaching(p: dict, rng, chance: float = 0.8) -> dict:
 # metres for TORSO. A bat or racket held at one shoulder (the far arm crosses the chest), a ball or club held
 # before the belly or the chest, raised to throw or shoot, or overhead
 GRIPS = {
-    "shoulder": ("shoulder.g", (-0.10, 0.06), (-0.06, 0.28), (0.06, 0.30)),
+    "shoulder": ("shoulder.s", (-0.10, 0.06), (-0.06, 0.28), (0.06, 0.30)),
     "low": ("belly", (-0.16, 0.16), (-0.28, 0.06), (0.16, 0.45)),
     "high": ("chest", (-0.20, 0.20), (0.00, 0.36), (0.18, 0.50)),
     "overhead": ("head", (-0.16, 0.16), (0.08, 0.34), (-0.05, 0.22)),
@@ -126,9 +126,8 @@ def gripping(p: dict, rng) -> dict:
     centre, lr, ur, fr = GRIPS[name]
     g = "L" if rng.random() < 0.5 else "R"
     out = lat if g == "L" else -lat   # at one shoulder, lateral ranges are outward from it
-    base = p[f"shoulder.{g}"] if centre == "shoulder.g" else _centre(p, centre, g)
-    target = base + scale * (rng.uniform(*lr) * (out if centre == "shoulder.g" else lat)
-                             + rng.uniform(*ur) * up + rng.uniform(*fr) * fwd)
+    target = _centre(p, centre, g) + scale * (rng.uniform(*lr) * (out if centre == "shoulder.s" else lat)
+                                              + rng.uniform(*ur) * up + rng.uniform(*fr) * fwd)
     handle = _unit(rng.normal(size=3))
     half = 0.5 * scale * rng.uniform(*GRIP_SPREAD) * handle
     p = reach_arm(p, "L", target + half, rng)
