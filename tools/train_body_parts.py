@@ -45,6 +45,7 @@ import multiprocessing
 import sys
 import time
 from dataclasses import replace
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -215,7 +216,7 @@ def person_grids(first: int, count: int):
     cam, seed, out = _W["cam"], _W["seed"], []
     body = None
     for i in range(first, first + count):
-        if _W.get("skip_skirts") and _skirt_drawn(np.random.default_rng([seed, 2, i // PER_BODY])):
+        if _W.get("skip_skirts") and skirted(seed, i // PER_BODY):
             out.append(None)   # left out anyway (--no-skirts): not rendered
             continue
         if body is None or i % PER_BODY == 0:
@@ -287,19 +288,14 @@ def make_data(args):
               for f in range(GRIP_FIRST, GRIP_FIRST + args.grip_images, CHUNK)]
     _setup(args.seed, False)
     _W["skip_skirts"] = args.no_skirts
-    # the images of performers who wear a skirt or coat hem are left out chunk by chunk (memory: the samples
-    # of 24,000 images are 11 GB)
-    skirted = skirted_performers(args.seed, args.images // PER_BODY + 1) if args.no_skirts else None
-    for first, n in ((REACH_FIRST, args.reach_images), (GRIP_FIRST, args.grip_images)):
-        if skirted is not None and n:   # the reaching (gripping) images' performers follow on
-            skirted = np.concatenate([skirted, np.zeros(first // PER_BODY - len(skirted), bool),
-                                      [_skirt_drawn(np.random.default_rng([args.seed, 2, first // PER_BODY + g]))
-                                       for g in range(n // PER_BODY + 1)]])
+    if args.no_skirts:
+        check_skirt_replay(args.seed, args.images // PER_BODY + 1)
     pool = _pool(args.jobs)
     xs, ys, left_out, t0 = [], [], 0, time.perf_counter()
     for k, (x, y, image) in enumerate(pool.imap(_chunk_samples, tasks) if pool else map(_chunk_samples, tasks)):
-        if skirted is not None:
-            keep = ~skirted[image // PER_BODY]
+        if args.no_skirts:   # left out chunk by chunk (memory: the samples of 24,000 images are 11 GB)
+            groups, which = np.unique(image // PER_BODY, return_inverse=True)
+            keep = ~np.array([skirted(args.seed, int(g)) for g in groups], bool)[which]
             left_out += int(np.sum(~keep))
             x, y = x[keep], y[keep]
         xs.append(x)
@@ -320,15 +316,20 @@ def make_data(args):
     return x, np.concatenate(ys), offsets
 
 
-def skirted_performers(seed: int, count: int) -> np.ndarray:
-    """(count,) bool: which of performers 0..count-1 wear a skirt or coat hem. performer()'s seeded draws are
-    replayed up to that choice without building the bodies, and checked against built bodies here."""
-    out = np.array([_skirt_drawn(np.random.default_rng([seed, 2, g])) for g in range(count)])
+@lru_cache(maxsize=None)
+def skirted(seed: int, g: int) -> bool:
+    """Whether performer g wears a skirt or coat hem: performer()'s seeded draws replayed up to that choice,
+    without building the body (check_skirt_replay keeps the replay honest)."""
+    return _skirt_drawn(np.random.default_rng([seed, 2, g]))
+
+
+def check_skirt_replay(seed: int, count: int) -> None:
+    """Build one skirted and one plain performer of 0..count-1 for real and check the replay agrees."""
+    out = np.array([skirted(seed, g) for g in range(count)])
     base = _W["base"]
-    for g in (int(np.argmax(out)), int(np.argmin(out))):   # one of each, built for real
+    for g in (int(np.argmax(out)), int(np.argmin(out))):
         body = performer(base, _W["vlab"], np.random.default_rng([seed, 2, g]), _W["cam"])[0]
         assert (len(body.rest_vertices) > len(base.rest_vertices)) == out[g], "skirt replay out of step"
-    return out
 
 
 def _skirt_drawn(rng) -> bool:
@@ -449,8 +450,8 @@ def main() -> None:
     recount_leaves(rf, x, y)
     forest = flatten(rf, offsets)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    forest.save(args.out, images=args.images, reach_images=args.reach_images, grip_images=args.grip_images, pixels=args.pixels, trees=args.trees,
-                depth=args.depth,
+    forest.save(args.out, images=args.images, reach_images=args.reach_images, grip_images=args.grip_images,
+                pixels=args.pixels, trees=args.trees, depth=args.depth,
                 seed=args.seed, balance=args.balance, no_skirts=args.no_skirts, samples=int(len(y)), data_s=round(t1 - t0), train_s=round(time.perf_counter() - t1))
     print(f"wrote {args.out}: {len(forest.feature)} nodes, depth {forest.depth} "
           f"({Path(args.out).stat().st_size / 1e6:.1f} MB); training took {time.perf_counter() - t1:.0f} s")
