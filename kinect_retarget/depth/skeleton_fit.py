@@ -1,13 +1,14 @@
 """Fit the 20-joint Kinect v1 skeleton to one segmented person (numpy only).
 
 Per frame: a torso patch (geodesic disc around where the forest sees the torso, else the last spine) gives
-the torso frame, the line between the forest's shoulder parts (or else the chest's surface normals, facing.py)
-its facing; geodesic extrema give head, hand and foot candidates; level-set centroids (paper 003) near each
-extremity give hand/wrist and foot/ankle; elbows and knees come from two-bone inverse kinematics with the
-calibrated bone lengths, choosing on the IK circle the point that best agrees with the depth image
-(projective check), the level-set centroid and the previous frame. An extremity at the image's edge or beside
-a nearer surface is where the view of the limb ends (limb_ends). Arms are then fitted against the depth
-(arm_search): the elbow of a tracked hand, and the whole of an arm whose hand is not a tracked extremity.
+the torso frame, the line between the forest's shoulder parts or upper torso quarters (part_lines; else the
+chest's surface normals, facing.py) its facing; geodesic extrema give head, hand and foot candidates;
+level-set centroids (paper 003) near each extremity give hand/wrist and foot/ankle; elbows and knees come
+from two-bone inverse kinematics with the calibrated bone lengths, choosing on the IK circle the point that
+best agrees with the depth image (projective check), the level-set centroid and the previous frame. An
+extremity at the image's edge or beside a nearer surface is where the view of the limb ends (limb_ends).
+Arms are then fitted against the depth (arm_search): the elbow of a tracked hand, and the whole of an arm
+whose hand is not a tracked extremity.
 Legs without evidence keep their previous pose relative to the torso; both are reported inferred.
 """
 from __future__ import annotations
@@ -20,11 +21,13 @@ from ..core.skeletons import INFERRED, TRACKED
 from . import body_model_fit as bm
 from .arm_search import SIDES, J, TorsoFrame, fit_arms
 from .facing import chest_facing
-from .surface_geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
 from .limb_fit import LimbScene, _nearest_cell, fit_limb
 from .part_fit import USE_CONFIDENCE, shoulders_on_parts
+from .part_lines import (LINE_AGREE_DEG, NORMALS_AGREE_DEG, checked_by_torso, line_facing, shoulder_line,
+                         torso_line)
 from .part_proposals import torso_seen
 from .sides import assign_sides
+from .surface_geodesic import SurfaceGraph, geodesic_extrema, level_set_centroid
 from .two_bone import unit as _unit
 
 HEAD_AXIS_WEIGHT = 0.65      # torso axis pulled this far toward the line from the torso patch to the head top
@@ -46,13 +49,6 @@ SIDE_ON_DEG = 75.0          # chest facing this far from the sensor: side-on, th
 TURN_JUMP_FROM_DEG = 15.0   # facing the sensor within this, a turn of ...
 TURN_JUMP_DEG = 25.0        # ... more than this in one frame is not believed ...
 TURN_CREEP_DEG = 3.0        # ... and the left-right direction turns toward it by this much a frame
-# the torso's left-right direction from the line between the forest's shoulder parts: on real depth (UTD-MHAD
-# subjects 1-2) that line's yaw lay 4.6 degrees from the SDK's shoulders (median 2.3), the chest's normals 12.1
-# (7.2): arms held before the chest tilt them, and Kinect v1's depth steps make flat patches whose normals
-# face the sensor (a fifth to two fifths of a turned chest's cells), so turns of 52-72 degrees read as none
-SHOULDER_LINE = True
-SHOULDER_LINE_CONFIDENCE = USE_CONFIDENCE   # square metres of likely part around each shoulder's proposal
-SHOULDER_LINE_SPAN = (0.2, 0.55)    # m between the two proposals: a shoulder line, not a confused part
 LATERAL_SMOOTHING = 0.25    # weight of the last frame's left-right direction (0.5 before the shoulder line)
 
 
@@ -128,7 +124,8 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
     # bend the last place is the trunk's lower half, from which the disc did not climb back up)
     seen = None if proposals is None else torso_seen(proposals, grid.xyz)
     torso = _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral,
-                         prev_centre if seen is None else seen, shoulder_line(proposals))
+                         prev_centre if seen is None else seen, shoulder_line(proposals),
+                         torso_line(proposals, grid))
     if torso is None:
         return None
     d0, loose, centre, axis, lat, facing, view, edge_on, narrow = torso
@@ -204,34 +201,11 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
     return FitResult(pos, st, lat, labels, centre, proj, edge_on or narrow, turned, axis, patch_centre)
 
 
-def shoulder_line(proposals) -> np.ndarray | None:
-    """Right shoulder -> left shoulder of the forest's shoulder parts, where it sees both and they lie a
-    shoulder width apart; else None."""
-    if not SHOULDER_LINE or proposals is None:
-        return None
-    left, right = J["ShoulderLeft"], J["ShoulderRight"]
-    if min(proposals.confidence[left], proposals.confidence[right]) < SHOULDER_LINE_CONFIDENCE:
-        return None
-    line = proposals.positions[left] - proposals.positions[right]
-    return line if SHOULDER_LINE_SPAN[0] < np.linalg.norm(line) < SHOULDER_LINE_SPAN[1] else None
-
-
-def _line_facing(line: np.ndarray | None, axis: np.ndarray, toward: np.ndarray) -> np.ndarray | None:
-    """The facing (across `axis`) square to a shoulder line, or None without one or where it would face away
-    from the sensor (`toward`): the performer is taken to face it, as with the chest's normals."""
-    if line is None:
-        return None
-    square = np.cross(line, axis)   # across the axis, whatever the line's tilt along it
-    if np.linalg.norm(square) < 1e-6:
-        return None
-    facing = _unit(square)
-    return facing if facing @ toward > 0 else None
-
-
-def _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, seed_at, line=None):
+def _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, seed_at, line=None, quarters=None):
     """The torso: a geodesic disc around `seed_at` (or the person's middle) gives its centre and long
-    axis; the shoulder `line` (shoulder_line) or else the chest's normals its facing, kept through side-on
-    views. None when the person has no torso.
+    axis; the right -> left `line` of the forest's shoulders or else the chest's normals its facing, unless
+    the line of its upper torso `quarters` says they read too little of a turn (part_lines), kept through
+    side-on views. None when the person has no torso.
     Returns (d0 geodesic distances from the seed, the graph that reached every part, centre, axis, lat,
     facing, view, edge_on, narrow)."""
     H = calib.height
@@ -262,9 +236,12 @@ def _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral, see
     edge_on = bool(facing @ -view < 0.3)
     toward = _unit(-view - (-view @ axis) * axis)
     # the facing read from the shoulders' parts where the forest sees both, else from the chest's normals
-    chest = _line_facing(line, axis, toward)
+    # (checked by the forest's upper torso, which reads a turn surely, if not all of it)
+    chest, agree = line_facing(line, axis, toward), LINE_AGREE_DEG
     if chest is None:
         chest = chest_facing(xyz, mask, centre - axis * calib.torso_patch_height * H, axis, H)
+        agree = NORMALS_AGREE_DEG
+    chest = checked_by_torso(chest, line_facing(quarters, axis, toward), axis, toward, agree)
     held = prev_lateral is not None and (chest is None or chest @ toward < np.cos(np.radians(SIDE_ON_DEG)))
     if held:  # side-on the chest's direction is ambiguous: keep the last one until the turn goes on
         lat = _unit(prev_lateral - (prev_lateral @ axis) * axis)
