@@ -101,4 +101,5 @@ def checked_by_torso(reading: np.ndarray | None, torso: np.ndarray | None, axis:
 
 
 def _signed_turn_deg(facing: np.ndarray, axis: np.ndarray, toward: np.ndarray) -> float:
+    """Degrees a facing is turned from the sensor's direction about `axis`, signed by the way it turns."""
     return float(np.degrees(np.arctan2(np.cross(toward, facing) @ axis, toward @ facing)))
