@@ -1,7 +1,8 @@
-"""The torso's left-right direction from the forest's parts (part_lines): the line between its shoulder parts, or
-between its upper torso quarters where that is missing or disagrees. On real depth the chest's normals read a
-turned performer as facing the sensor (Kinect v1's depth steps make flat patches that face it), the parts did not;
-an arm raised before its shoulder carries the shoulder's part with it, the torso's quarters stay on the chest."""
+"""The torso's left-right direction from the forest's parts (part_lines): the line between its shoulder parts
+(else the chest's normals), checked by the line between its upper torso quarters. On real depth the chest's
+normals read a turned performer as facing the sensor (Kinect v1's depth steps make flat patches that face it),
+the parts did not; an arm raised before its shoulder carries the shoulder's part with it, the torso's quarters
+stay on the chest."""
 from __future__ import annotations
 
 from types import SimpleNamespace
@@ -13,8 +14,9 @@ from kinect_retarget.core.skeletons import KINECT_V1
 from kinect_retarget.depth import skeleton_fit
 from kinect_retarget.depth.body_parts import PART, PARTS
 from kinect_retarget.depth.depth_camera import DepthCamera
-from kinect_retarget.depth.part_lines import (LINE_AGREE_DEG, NORMALS_AGREE_DEG, SHOULDER_LINE_CONFIDENCE, TORSO_LINE_MASS,
-                                              checked_by_torso, line_facing, shoulder_line, torso_line)
+from kinect_retarget.depth.part_lines import (LINE_AGREE_DEG, NORMALS_AGREE_DEG, SHOULDER_LINE_CONFIDENCE,
+                                              TORSO_LINE_MASS, checked_by_torso, line_facing, shoulder_line,
+                                              torso_line)
 from kinect_retarget.depth.part_proposals import Proposals
 from kinect_retarget.depth.skeleton_tracker import SkeletonTracker, TrackerSettings
 
