@@ -419,6 +419,8 @@ def main() -> None:
     ap.add_argument("--trees", type=int, default=3)
     ap.add_argument("--depth", type=int, default=20)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--tree-seed", type=int,
+                    help="the trees' own randomness (default --seed): more trees on the same images")
     ap.add_argument("--jobs", type=int, default=2, help="rendering processes (the data do not depend on it)")
     ap.add_argument("--balance", type=float, default=1.0,
                     help="weight samples by part frequency ** -BALANCE while growing the trees (0: unweighted)")
@@ -443,15 +445,16 @@ def main() -> None:
     from sklearn.ensemble import RandomForestClassifier
     print(f"training {args.trees} trees of depth {args.depth} on {x.shape[1]} candidate features", flush=True)
     freq = np.bincount(y, minlength=len(PARTS)) / len(y)
+    tree_seed = args.seed if args.tree_seed is None else args.tree_seed
     weight = np.maximum(freq, 1e-9)[y] ** -args.balance
     rf = RandomForestClassifier(n_estimators=args.trees, max_depth=args.depth, max_features=40,
-                                min_samples_leaf=5, random_state=args.seed, n_jobs=1)
+                                min_samples_leaf=5, random_state=tree_seed, n_jobs=1)
     rf.fit(x, y, sample_weight=weight * (len(y) / weight.sum()))
     recount_leaves(rf, x, y)
     forest = flatten(rf, offsets)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     forest.save(args.out, images=args.images, reach_images=args.reach_images, grip_images=args.grip_images,
-                pixels=args.pixels, trees=args.trees, depth=args.depth, seed=args.seed, balance=args.balance,
+                pixels=args.pixels, trees=args.trees, depth=args.depth, seed=args.seed, tree_seed=tree_seed, balance=args.balance,
                 no_skirts=args.no_skirts, samples=int(len(y)), data_s=round(t1 - t0),
                 train_s=round(time.perf_counter() - t1))
     print(f"wrote {args.out}: {len(forest.feature)} nodes, depth {forest.depth} "
