@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from kinect_retarget.core.skeletons import KINECT_V1
 from kinect_retarget.depth.body_parts import BACKGROUND, PART, PARTS
@@ -63,15 +64,19 @@ def test_part_labels_from_skin_weights(data_dir):
     assert len(cols) > 20 and np.all(cols > cam.cx)   # facing the sensor, the left hand is on the image's right
 
 
-def test_forest_classifies_as_a_node_by_node_walk_with_probe_features(rendered):
-    # the fast path reads probes from a framed grid; the reference follows each cell down each tree
-    from kinect_retarget.depth.part_forest import probe_features
+@pytest.mark.parametrize("nearer", [1.0, 0.12])
+def test_forest_classifies_as_a_node_by_node_walk_with_probe_features(rendered, nearer):
+    # the fast path reads node records and probes from a grid in a background margin; the reference follows
+    # each cell down each tree. nearer 0.12 puts the performer 0.3 m away, beyond the margin's cap
+    from kinect_retarget.depth.part_forest import MAX_MARGIN, probe_features
     forest = load_forest(MODEL_PATH)
     seq, _ = rendered
     tracker = SkeletonTracker(gravity=seq.gravity, settings=TrackerSettings(part_forest=None))
     tracker.update(seq.mm[0], seq.times[0])
     grid, mask = tracker.last_grid, tracker.last_mask
-    zb = np.where(mask, grid.z, 10.0)
+    zb = np.where(mask, grid.z * nearer, 10.0)
+    if nearer < 1:
+        assert forest.reach * grid.camera.f / grid.step / zb[mask].min() > MAX_MARGIN
     zb[:, :3] = 0.8                                       # near probes at the image's edge too
     rows, cols = np.nonzero(mask)
     pick = np.random.default_rng(3).choice(len(rows), 60, replace=False)
