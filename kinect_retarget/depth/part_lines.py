@@ -53,22 +53,19 @@ def shoulder_line(proposals) -> np.ndarray | None:
     return line if SHOULDER_LINE_SPAN[0] < np.linalg.norm(line) < SHOULDER_LINE_SPAN[1] else None
 
 
-def torso_line(proposals, grid) -> np.ndarray | None:
+def torso_line(proposals) -> np.ndarray | None:
     """Centre of the upper torso's right quarter -> its left quarter's (each cell weighted, as the proposals'
     votes are, by its probability times the area it stands for), where the forest sees both quarters; else
-    None. `grid`: the segmentation.DepthGrid the proposals' cells index."""
+    None."""
     if not TORSO_LINE or proposals is None or not len(proposals.probs):
         return None
-    rows, cols = proposals.cells
-    pts = grid.xyz[rows, cols]
-    area = pts[:, 2] ** 2 * (grid.step / grid.camera.f) ** 2
     centres = []
     for part in UPPER_QUARTERS:
         p = proposals.probs[:, part]
-        w = np.where(p > PROB_MIN, p, 0.0) * area
+        w = np.where(p > PROB_MIN, p, 0.0) * proposals.areas
         if w.sum() < TORSO_LINE_MASS:
             return None
-        centres.append(w @ pts / w.sum())
+        centres.append(w @ proposals.points / w.sum())
     return centres[0] - centres[1]
 
 

@@ -42,6 +42,8 @@ class Proposals:
     confidence: np.ndarray   # (20,) square metres of likely part around the proposal; 0 = no proposal
     cells: tuple             # (rows, cols) of the classified grid cells
     probs: np.ndarray        # (N, parts) their part probabilities
+    points: np.ndarray       # (N, 3) their camera-space points
+    areas: np.ndarray        # (N,) square metres of surface each stands for (the proposals' vote weights)
 
 
 def propose(forest: PartForest, grid, mask: np.ndarray) -> Proposals:
@@ -77,7 +79,7 @@ def propose(forest: PartForest, grid, mask: np.ndarray) -> Proposals:
             if away.sum() >= 3:
                 mode, conf[weaker] = _mean_shift(x[away], w[away], pr[away])
                 pos[weaker] = _behind(mode, KINECT_V1.joints[weaker])
-    return Proposals(pos, conf, (rows, cols), probs)
+    return Proposals(pos, conf, (rows, cols), probs, pts, area)
 
 
 def _mean_shift(x: np.ndarray, w: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, float]:
@@ -97,14 +99,13 @@ def _behind(surface: np.ndarray, joint: str) -> np.ndarray:
     return surface + surface / np.linalg.norm(surface) * DEPTH_INSIDE[kind]
 
 
-def torso_seen(props: Proposals, xyz: np.ndarray) -> np.ndarray | None:
+def torso_seen(props: Proposals) -> np.ndarray | None:
     """Where the forest sees the torso: the median of the cells likely to be one of its quarters, leaving out
-    those well before the rest (an arm folded across the chest that the forest takes for torso). `xyz`: the
-    grid's camera-space points. None when too few cells are the torso's."""
+    those well before the rest (an arm folded across the chest that the forest takes for torso). None when
+    too few cells are the torso's."""
     sel = props.probs[:, TORSO_PARTS].sum(axis=1) > TORSO_PROB
     if sel.sum() < TORSO_CELLS:
         return None
-    rows, cols = props.cells
-    pts = xyz[rows[sel], cols[sel]]
+    pts = props.points[sel]
     pts = pts[pts[:, 2] > np.median(pts[:, 2]) - TORSO_FRONT]
     return np.median(pts, axis=0)

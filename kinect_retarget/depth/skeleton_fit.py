@@ -122,10 +122,10 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
     H = calib.height
     # the torso's disc grows from where the forest sees the torso now, else from where it was (after a deep
     # bend the last place is the trunk's lower half, from which the disc did not climb back up)
-    seen = None if proposals is None else torso_seen(proposals, grid.xyz)
+    seen = None if proposals is None else torso_seen(proposals)
     torso = _torso_frame(grid, mask_full, xyz, mask, graph, up, calib, prev_lateral,
                          prev_centre if seen is None else seen, shoulder_line(proposals),
-                         torso_line(proposals, grid))
+                         torso_line(proposals))
     if torso is None:
         return None
     d0, loose, centre, axis, lat, facing, view, edge_on, narrow = torso

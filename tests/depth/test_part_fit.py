@@ -16,7 +16,8 @@ FACING = part_fit.body_frame(np.array([-1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0
 
 
 def _proposals(pos, conf=0.01):
-    return Proposals(pos.copy(), np.full(20, conf), (np.zeros(0, int), np.zeros(0, int)), np.zeros((0, len(PARTS))))
+    return Proposals(pos.copy(), np.full(20, conf), (np.zeros(0, int), np.zeros(0, int)), np.zeros((0, len(PARTS))),
+                     np.zeros((0, 3)), np.zeros(0))
 
 
 def _standing_pose():

@@ -29,7 +29,8 @@ def _proposals(left, right, confidence=2 * SHOULDER_LINE_CONFIDENCE) -> Proposal
     pos, conf = np.zeros((20, 3)), np.zeros(20)
     pos[LEFT], pos[RIGHT] = left, right
     conf[[LEFT, RIGHT]] = confidence
-    return Proposals(pos, conf, (np.zeros(0, int), np.zeros(0, int)), np.zeros((0, len(PARTS))))
+    return Proposals(pos, conf, (np.zeros(0, int), np.zeros(0, int)), np.zeros((0, len(PARTS))), np.zeros((0, 3)),
+                     np.zeros(0))
 
 
 def _turned(deg: float) -> np.ndarray:
@@ -80,41 +81,41 @@ def test_the_fitted_torso_turns_with_the_shoulder_line(rendered, monkeypatch):
 GRID = SimpleNamespace(step=4, camera=DepthCamera())   # cells of 4 pixels: about 1.7 cm across at 2.5 m
 
 
-def _quarters(left_centre, right_centre, cells=40, p=0.9, rng=None):
-    """Proposals over a grid whose first `cells` cells are the upper torso's left quarter (around
-    `left_centre`), the next ones its right quarter, each with part probability `p`."""
+def _quarters(left_centre, right_centre, cells=40, p=0.9, rng=None) -> Proposals:
+    """Proposals whose first `cells` cells are the upper torso's left quarter (around `left_centre`), the
+    next ones its right quarter, each with part probability `p`."""
     rng = rng or np.random.default_rng(0)
     xyz = np.concatenate([c + rng.normal(0.0, 0.04, (cells, 3)) for c in (left_centre, right_centre)])
     probs = np.zeros((2 * cells, len(PARTS)))
     probs[:cells, PART["torso_upper_left"]] = p
     probs[cells:, PART["torso_upper_right"]] = p
     probs[:, PART["head"]] = 1.0 - p
-    grid = SimpleNamespace(xyz=xyz[None], step=GRID.step, camera=GRID.camera)
+    areas = xyz[:, 2] ** 2 * (GRID.step / GRID.camera.f) ** 2   # a cell stands for more surface farther away
     cells_rc = (np.zeros(2 * cells, int), np.arange(2 * cells))
-    return Proposals(np.zeros((20, 3)), np.zeros(20), cells_rc, probs), grid
+    return Proposals(np.zeros((20, 3)), np.zeros(20), cells_rc, probs, xyz, areas)
 
 
 def test_the_torso_line_joins_the_upper_quarters_centres():
     centre = np.array([0.1, 0.4, 2.5])
-    props, grid = _quarters(centre + 0.1 * _turned(40), centre - 0.1 * _turned(40))
-    line = torso_line(props, grid)
-    pts = grid.xyz[0]
+    props = _quarters(centre + 0.1 * _turned(40), centre - 0.1 * _turned(40))
+    line = torso_line(props)
+    pts = props.points
     w = pts[:, 2] ** 2   # a cell stands for more surface the farther it is
     left, right = (np.average(pts[k], axis=0, weights=w[k]) for k in (slice(0, 40), slice(40, 80)))
     assert line is not None and np.allclose(line, left - right)
     assert _angle(line, _turned(40)) < 5.0
-    assert torso_line(None, grid) is None
+    assert torso_line(None) is None
 
 
 def test_the_torso_line_needs_both_quarters_seen():
     centre = np.array([0.0, 0.3, 2.5])
     area = 2.5 ** 2 * (GRID.step / GRID.camera.f) ** 2   # square metres one cell stands for at 2.5 m
     few = int(TORSO_LINE_MASS / (0.9 * area) * 0.5)      # half the mass a quarter needs
-    assert torso_line(*_quarters(centre + 0.1 * _turned(0), centre - 0.1 * _turned(0), cells=few)) is None
+    assert torso_line(_quarters(centre + 0.1 * _turned(0), centre - 0.1 * _turned(0), cells=few)) is None
     enough = int(TORSO_LINE_MASS / (0.9 * area) * 2) + 1
-    assert torso_line(*_quarters(centre + 0.1 * _turned(0), centre - 0.1 * _turned(0), cells=enough)) is not None
+    assert torso_line(_quarters(centre + 0.1 * _turned(0), centre - 0.1 * _turned(0), cells=enough)) is not None
     # cells no likelier than the proposals' threshold are not the part's
-    assert torso_line(*_quarters(centre + 0.1 * _turned(0), centre - 0.1 * _turned(0), cells=200, p=0.1)) is None
+    assert torso_line(_quarters(centre + 0.1 * _turned(0), centre - 0.1 * _turned(0), cells=200, p=0.1)) is None
 
 
 def _facing(deg: float) -> np.ndarray:
@@ -158,7 +159,7 @@ def test_a_turned_performer_s_torso_quarters_read_the_turn(data_dir):
                           Scenario(turn_deg=40.0, seed=8), start=0, frames=1)
     tracker = SkeletonTracker(gravity=seq.gravity, settings=TrackerSettings(steady_output=False))
     tracker.update(seq.mm[0], seq.times[0])
-    line = torso_line(tracker.last_proposals, tracker.last_grid)
+    line = torso_line(tracker.last_proposals)
     gt = seq.joints[0]
     assert line is not None
     turn = lambda v: float(np.degrees(np.arctan2(v[2], -v[0])))   # yaw from a line facing the sensor

@@ -31,7 +31,7 @@ def test_sunk_torso_climbs_back_to_where_the_torso_is_seen_or_to_a_confirmed_hea
     assert _shoulder_centre_error_after_sinking(seq) < 0.08
     monkeypatch.setattr(skeleton_fit, "FAR_HEAD_SHIFT", 1.0)   # the head refused: the seen torso alone
     assert _shoulder_centre_error_after_sinking(seq) < 0.08
-    monkeypatch.setattr(skeleton_fit, "torso_seen", lambda props, xyz: None)   # neither: the torso stays low
+    monkeypatch.setattr(skeleton_fit, "torso_seen", lambda props: None)   # neither: the torso stays low
     assert _shoulder_centre_error_after_sinking(seq) > 0.2
     monkeypatch.setattr(skeleton_fit, "FAR_HEAD_SHIFT", 0.25)   # the confirmed head alone
     assert _shoulder_centre_error_after_sinking(seq) < 0.08
@@ -48,11 +48,11 @@ def test_the_seen_torso_is_the_median_of_its_likely_cells_behind_a_folded_arm():
     probs[:, TORSO_PARTS[0]] = 0.6               # the torso's upper left quarter
     probs[:60, TORSO_PARTS] = 0.02               # not the torso's (0.08 in all)
     xyz[rows[60:100], cols[60:100]] += [0.3, 0.0, -0.1]   # a forearm folded 10 cm before the chest, taken for torso
-    props = Proposals(np.zeros((20, 3)), np.zeros(20), (rows, cols), probs)
+    props = Proposals(np.zeros((20, 3)), np.zeros(20), (rows, cols), probs, xyz[rows, cols], np.ones(n))
     torso = xyz[rows[100:], cols[100:]]
-    assert np.allclose(torso_seen(props, xyz), np.median(torso, axis=0))
+    assert np.allclose(torso_seen(props), np.median(torso, axis=0))
     probs[60 + TORSO_CELLS - 1:, TORSO_PARTS] = 0.0   # too few torso cells left: not seen
-    assert torso_seen(props, xyz) is None
+    assert torso_seen(props) is None
 
 
 def test_an_uncalibrated_tracker_believes_a_confirmed_head_top_far_from_its_guess(data_dir):
