@@ -93,7 +93,8 @@ class PartForest:
         scale = cells_per_m / zb[rows, cols]
         # the grid in a margin of background as wide as the farthest probe, so no probe needs a bounds test
         # (capped for cells implausibly near the sensor, whose probes are then clipped into the margin)
-        need = int(np.ceil(self.reach * scale.max())) + 1 if len(rows) else 1
+        top = float(scale.max()) if len(rows) else 0.0
+        need = int(np.ceil(self.reach * top)) + 1 if np.isfinite(top) else MAX_MARGIN + 1   # no depth: clip
         pad = min(need, MAX_MARGIN)
         framed = np.full((h + 2 * pad, w + 2 * pad), BACKGROUND_DEPTH)
         framed[pad:pad + h, pad:pad + w] = zb

@@ -110,3 +110,25 @@ def test_probe_features_read_background_off_the_grid():
                 c = cols[i] + int(np.rint(probe[0] * 140.0 / zb[rows[i], cols[i]]))
                 vals.append(zb[r, c] if 0 <= r < 30 and 0 <= c < 40 else BACKGROUND_DEPTH)
             assert got[i, k] == vals[0] - vals[1]
+
+
+def test_a_cell_without_depth_leaves_the_other_cells_as_they_were(rendered):
+    # no tracked cell should lack depth, but one that does (0 or NaN) must not stop the frame's classification
+    forest = load_forest(MODEL_PATH)
+    seq, _ = rendered
+    tracker = SkeletonTracker(gravity=seq.gravity, settings=TrackerSettings(part_forest=None))
+    tracker.update(seq.mm[0], seq.times[0])
+    grid, mask = tracker.last_grid, tracker.last_mask
+    zb = np.where(mask, grid.z, 10.0)
+    rows, cols = np.nonzero(mask)
+    cells_per_m = grid.camera.f / grid.step
+    clean = forest.classify(zb, rows, cols, cells_per_m)
+    for bad in (0.0, np.nan):
+        broken = zb.copy()
+        broken[rows[0], cols[0]] = bad
+        with np.errstate(all="ignore"):
+            probs = forest.classify(broken, rows, cols, cells_per_m)
+        assert probs.shape == clean.shape and np.allclose(probs[0].sum(), 1.0, atol=0.05)
+        # only cells whose probes could read that cell may differ
+        far = np.hypot(rows - rows[0], cols - cols[0]) > forest.reach * cells_per_m / zb[mask].min() + 1
+        assert far.sum() > 10 and np.array_equal(probs[far], clean[far])
