@@ -454,8 +454,8 @@ def main() -> None:
     forest = flatten(rf, offsets)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     forest.save(args.out, images=args.images, reach_images=args.reach_images, grip_images=args.grip_images,
-                pixels=args.pixels, trees=args.trees, depth=args.depth, seed=args.seed, tree_seed=tree_seed, balance=args.balance,
-                no_skirts=args.no_skirts, samples=int(len(y)), data_s=round(t1 - t0),
+                pixels=args.pixels, trees=args.trees, depth=args.depth, seed=args.seed, tree_seed=tree_seed,
+                balance=args.balance, no_skirts=args.no_skirts, samples=int(len(y)), data_s=round(t1 - t0),
                 train_s=round(time.perf_counter() - t1))
     print(f"wrote {args.out}: {len(forest.feature)} nodes, depth {forest.depth} "
           f"({Path(args.out).stat().st_size / 1e6:.1f} MB); training took {time.perf_counter() - t1:.0f} s")

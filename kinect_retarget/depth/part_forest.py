@@ -111,8 +111,8 @@ class PartForest:
             if need > pad:
                 np.clip(probe, -pad, pad, out=probe)
             probe[0::2] *= stride
-            depth = framed[probe[0::2] + probe[1::2] + at]
-            node = np.where(depth[0] - depth[1] <= fields[4], nodes[6], nodes[5])
+            probed = framed[probe[0::2] + probe[1::2] + at]   # d(x + u), d(x + v)
+            node = np.where(probed[0] - probed[1] <= fields[4], nodes[6], nodes[5])
         probs = self.leaf_probs[node].reshape(len(rows), t, -1).astype(np.float32)
         return probs.mean(axis=1) * (1.0 / 255.0)
 
