@@ -29,6 +29,7 @@ from ..core.skeletons import KINECT_V1
 from .body_parts import PART
 from .part_fit import USE_CONFIDENCE
 from .part_proposals import PROB_MIN
+from .two_bone import unit
 
 SHOULDER_LINE = True
 SHOULDER_LINE_CONFIDENCE = USE_CONFIDENCE   # square metres of likely part around each shoulder's proposal
@@ -77,7 +78,7 @@ def line_facing(line: np.ndarray | None, axis: np.ndarray, toward: np.ndarray) -
     square = np.cross(line, axis)   # across the axis, whatever the line's tilt along it
     if np.linalg.norm(square) < 1e-6:
         return None
-    facing = square / np.linalg.norm(square)
+    facing = unit(square)
     return facing if facing @ toward > 0 else None
 
 
