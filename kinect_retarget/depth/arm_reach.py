@@ -24,12 +24,12 @@ import numpy as np
 
 from ..core.skeletons import KINECT_V1, TRACKED
 from . import body_model_fit as bm
-from .part_fit import ELBOW_TO_HAND, SIDES
+from .part_fit import ELBOW_TO_HAND, REACH_MAX_SHARE, SIDES
 
 J = KINECT_V1.index
 SHOULDERS = np.array([J(f"Shoulder{s}") for s in SIDES])
 ARMS = np.array([[J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand")] for s in SIDES])   # below each shoulder
-REACH_MAX = 1.45 * ELBOW_TO_HAND        # no hand is farther from its elbow than this
+REACH_MAX = REACH_MAX_SHARE * ELBOW_TO_HAND   # no hand is farther from its elbow than this
 PROPOSAL_REACH = (0.1, 0.21)            # a hand proposal this far from the elbow is a hand on this forearm
 MAX_ARM_SPEED = 7.5     # m/s (25 cm in a 30 Hz frame)
 HOLD_S = 0.15           # an arm is held at most this long (5 frames at 30 Hz) before what is seen is taken

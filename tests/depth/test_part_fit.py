@@ -443,3 +443,35 @@ def test_an_elbow_out_of_its_forearm_reach_of_a_sure_hand_is_solved_between_shou
     off = pos.copy()
     part_fit.apply_proposals(off, st.copy(), props, h, frame=FACING)
     assert np.allclose(off[j("ElbowLeft")], props.positions[j("ElbowLeft")])
+
+
+def test_a_searched_arm_keeps_its_elbow_against_a_part_its_hand_cannot_reach(no_offsets, monkeypatch):
+    """The baseball swing's wind-up: the left arm crosses the chest to the grip at the right shoulder, where the
+    fit's search placed it (elbow and hand doubted); the forest sees no left hand there and a left elbow hanging
+    on the trunk's left edge, 46 cm from that hand. The elbow stays: taking it would break the forearm."""
+    h = 1.7
+    pos, st = _standing_pose()
+    st[[j("ElbowLeft"), j("WristLeft"), j("HandLeft")]] = INFERRED
+    pos[j("ElbowLeft")], pos[j("HandLeft")] = [0.0, 0.3, 2.3], [0.15, 0.42, 2.35]
+    props = _proposals(pos, conf=part_fit.USE_CONFIDENCE)
+    props.positions[j("ElbowLeft")] = [-0.19, 0.15, 2.5]
+    props.confidence[j("HandLeft")] = 0.0
+    assert np.linalg.norm(props.positions[j("ElbowLeft")] - pos[j("HandLeft")]) > part_fit.REACH_MAX_SHARE * \
+        part_fit.ELBOW_TO_HAND * h
+
+    def elbow_after(states, **patch):
+        for name, value in patch.items():
+            monkeypatch.setattr(part_fit, name, value)
+        out = pos.copy()
+        part_fit.apply_proposals(out, states.copy(), props, h, frame=FACING)
+        return out[j("ElbowLeft")]
+
+    assert np.allclose(elbow_after(st), pos[j("ElbowLeft")])
+    hand_found = st.copy()
+    hand_found[j("HandLeft")] = TRACKED   # the fit's hand an extremity it found, not a searched arm's: taken
+    assert np.allclose(elbow_after(hand_found), props.positions[j("ElbowLeft")])
+    assert np.allclose(elbow_after(st, SEARCHED_ARM_KEEPS_ELBOW=False), props.positions[j("ElbowLeft")])
+    monkeypatch.setattr(part_fit, "SEARCHED_ARM_KEEPS_ELBOW", True)
+    props.confidence[j("HandLeft")] = part_fit.USE_CONFIDENCE   # a sure hand part of its own: the elbow is taken
+    props.positions[j("HandLeft")] = [-0.05, 0.2, 2.4]
+    assert np.allclose(elbow_after(st), props.positions[j("ElbowLeft")])
