@@ -91,9 +91,10 @@ ELBOW_HAND_MAX = 1.3
 REACH_MAX_SHARE = 1.45
 # ... so an arm whose elbow and hand the fit both doubts (placed together, as arm_search places a whole arm on
 # the depth) keeps its elbow against an elbow part that far from its hand, when the hand has no sure part of
-# its own: the part alone would break the forearm, and the hand be folded down to it. In the real baseball swing's wind-up the left arm crosses the chest to the grip at the
-# right shoulder; the forest labels it the right arm's and sees a left elbow on the trunk's left edge, which
-# hung the searched arm (all 216 real sequences: limbs 8.56 -> 8.50 degrees, the swing 20.0 -> 19.4)
+# its own: the part alone would break the forearm, and the hand be folded down to it. In the real baseball
+# swing's wind-up the left arm crosses the chest to the grip at the right shoulder; the forest gives it to the
+# right arm and sees a left elbow on the trunk's left edge, which hung the searched arm (all 216 real
+# sequences: limbs 8.56 -> 8.50 degrees, the swing 20.0 -> 19.4)
 SEARCHED_ARM_KEEPS_ELBOW = True
 # joints whose proposals check the fit's states (not hips, knees or spine: the fit's states stand for those)
 CHECKED = np.array([not n.startswith(("Hip", "Knee", "Spine")) for n in KINECT_V1.joints])
