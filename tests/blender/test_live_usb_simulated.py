@@ -19,9 +19,12 @@ def test_live_usb_simulated_poses_records_and_bakes(tmp_path):
     assert stats["error"] is None and stats["received"] >= 30 and stats["applied"] >= 30
     take = load_take(rec)
     assert take.skeleton.name == "kinect_v1" and take.frame_count == stats["recorded"] >= 30
-    # the torso is tracked nearly throughout; limbs are honestly inferred often (hidden, searched, settling
-    # after the person is found: about half of the hop's limb samples, docs/depth_tracking.md)
+    # the torso is tracked most of the time; limbs are honestly inferred often (hidden, searched, settling
+    # after the person is found: about half of the hop's limb samples, docs/depth_tracking.md). How often
+    # depends on the machine: the tracker takes the newest frame of a 30 Hz stream, and on a slow 2-core
+    # machine (10 frames/s: every third frame of the hop) the torso was tracked in 68-88 % of frames, the
+    # trackers of stops 41 and 42 alike (seven runs each), above 80 % on faster ones
     torso = [take.skeleton.index(n) for n in ("HipCenter", "Spine", "ShoulderCenter", "Head")]
-    assert (take.states[:, torso] == 2).mean() > 0.8
+    assert (take.states[:, torso] == 2).mean() > 0.6
     assert take.tracked_fraction > 0.35
     assert out.is_file() and stats["action"]
