@@ -89,12 +89,12 @@ ELBOW_AGREE = 0.09
 ELBOW_HAND_MAX = 1.3
 # no hand is farther from its elbow than this many elbow-to-hand lengths (arm_reach folds one that is back)
 REACH_MAX_SHARE = 1.45
-# ... so an arm whose elbow and hand the fit both doubts (placed together, as arm_search places a whole arm on
-# the depth) keeps its elbow against an elbow part that far from its hand, when the hand has no sure part of
-# its own: the part alone would break the forearm, and the hand be folded down to it. In the real baseball
-# swing's wind-up the left arm crosses the chest to the grip at the right shoulder; the forest gives it to the
-# right arm and sees a left elbow on the trunk's left edge, which hung the searched arm (all 216 real
-# sequences: limbs 8.56 -> 8.50 degrees, the swing 20.0 -> 19.4)
+# ... so an arm whose hand the fit doubts (placed with its elbow, as arm_search places a whole arm on the
+# depth, reporting a well-explained elbow tracked) keeps its elbow against an elbow part that far from its
+# hand, when the hand has no sure part of its own: the part alone would break the forearm, and the hand be
+# folded down to it. In the real baseball swing's wind-up the left arm crosses the chest to the grip at the
+# right shoulder; the forest gives it to the right arm and sees a left elbow on the trunk's left edge, which
+# hung the searched arm (all 216 real sequences: limbs 8.56 -> 8.49 degrees, the swing 20.0 -> 19.2)
 SEARCHED_ARM_KEEPS_ELBOW = True
 # joints whose proposals check the fit's states (not hips, knees or spine: the fit's states stand for those)
 CHECKED = np.array([not n.startswith(("Hip", "Knee", "Spine")) for n in KINECT_V1.joints])
@@ -199,8 +199,7 @@ def _arm_chain(pos, st, p, conf, use, s, height) -> None:
 
 def _arm_direct(pos, st, p, conf, use, s, height) -> None:
     el, wr, ha = (J(f"{n}{s}") for n in ("Elbow", "Wrist", "Hand"))
-    searched = st[el] != TRACKED and st[ha] != TRACKED
-    keep_elbow = (SEARCHED_ARM_KEEPS_ELBOW and searched and use[el] and not use[ha]
+    keep_elbow = (SEARCHED_ARM_KEEPS_ELBOW and st[ha] != TRACKED and use[el] and not use[ha]
                   and np.linalg.norm(p[el] - pos[ha]) > REACH_MAX_SHARE * ELBOW_TO_HAND * height)
     if use[el] and not keep_elbow:
         pos[el], st[el] = p[el], _state(conf[el])

@@ -447,7 +447,7 @@ def test_an_elbow_out_of_its_forearm_reach_of_a_sure_hand_is_solved_between_shou
 
 def test_a_searched_arm_keeps_its_elbow_against_a_part_its_hand_cannot_reach(no_offsets, monkeypatch):
     """The baseball swing's wind-up: the left arm crosses the chest to the grip at the right shoulder, where the
-    fit's search placed it (elbow and hand doubted); the forest sees no left hand there and a left elbow hanging
+    fit's search placed it (the hand doubted); the forest sees no left hand there and a left elbow hanging
     on the trunk's left edge, 46 cm from that hand. The elbow stays: taking it would break the forearm."""
     h = 1.7
     pos, st = _standing_pose()
@@ -467,6 +467,9 @@ def test_a_searched_arm_keeps_its_elbow_against_a_part_its_hand_cannot_reach(no_
         return out[j("ElbowLeft")]
 
     assert np.allclose(elbow_after(st), pos[j("ElbowLeft")])
+    elbow_seen = st.copy()
+    elbow_seen[j("ElbowLeft")] = TRACKED   # the search explained the arm well and reported its elbow tracked
+    assert np.allclose(elbow_after(elbow_seen), pos[j("ElbowLeft")])
     hand_found = st.copy()
     hand_found[j("HandLeft")] = TRACKED   # the fit's hand an extremity it found, not a searched arm's: taken
     assert np.allclose(elbow_after(hand_found), props.positions[j("ElbowLeft")])
