@@ -31,6 +31,12 @@ LIMB = [j for chain in CHAINS for j in chain]
 PREDICTION_SLACK = np.full(20, 0.25)
 PREDICTION_SLACK[TORSO + SIDE_TORSO] = 0.10
 VELOCITY_DAMPING = 0.5   # a fraction of the last frame's velocity is carried on (prediction, not extrapolation)
+# The sensor's frame interval. A tracker slower than the sensor takes its newest frame, so it sees every second
+# or third one, unevenly: the prediction and its slack count the sensor frames that passed. Without that, a
+# hop streamed to a slow 2-core machine (10 frames/s tracked) had its torso demoted whenever a step of 4
+# frames followed one of 2.
+SENSOR_FRAME_S = 1.0 / 30.0
+MAX_FRAMES_COUNTED = 4   # a tracker at 7.5 frames/s; a longer gap is frames lost, and no motion carries over it
 MIN_EXTREMITIES = 3      # of head, hands and feet; fewer and the labelling of what was found is a guess
 WARMUP_FRAMES = 6        # frames after (re)acquisition before the fit counts as settled (0.2 s)
 # frames after (re)acquisition during which limbs are reported inferred (0.1 s): on real depth the limbs of
@@ -52,6 +58,7 @@ class ConfidenceCheck:
 
     def reset(self) -> None:
         self._history: list[np.ndarray] = []
+        self._times: list[float] = []   # their timestamps (s; nan where unknown)
         self._flag_age = np.full(20, RECOVERY_FRAMES + 1)
         self._frames = 0
         self._facing_frames = 0   # frames in a row the fit faced the sensor (not turned, not side-on)
@@ -66,26 +73,33 @@ class ConfidenceCheck:
         """Settled, and facing the sensor for as long: a turn's mirror image has left the history."""
         return self._facing_frames >= WARMUP_FRAMES
 
-    def predict(self) -> np.ndarray | None:
+    def _frames_since(self, timestamp: float | None) -> int:
+        """Sensor frames from the last output pose to `timestamp` (1 where either time is unknown)."""
+        return _sensor_frames(self._times[-1] if self._times else None, timestamp)
+
+    def predict(self, timestamp: float | None = None) -> np.ndarray | None:
+        """Where the motion so far puts the joints at `timestamp` (None: one sensor frame after the last)."""
         if not self._history:
             return None
         if len(self._history) == 1:
             return self._history[-1]
         a, b = self._history[-2], self._history[-1]
-        return b + VELOCITY_DAMPING * (b - a)
+        ratio = self._frames_since(timestamp) / _sensor_frames(self._times[-2], self._times[-1])
+        return b + VELOCITY_DAMPING * ratio * (b - a)
 
     def assess(self, positions: np.ndarray, states: np.ndarray, fit, own=None, ends_seen=frozenset(),
-               fresh=None) -> np.ndarray:
+               fresh=None, timestamp: float | None = None) -> np.ndarray:
         """States after the checks (never promotes a joint). `fit` is the frame's FitResult; `own` ((20,) bool):
         joints placed on their own evidence (a foot on its body-part proposal), not hanging on the limb above;
         `ends_seen`: extremities ("head", "HandLeft", ...) the body-part forest saw, counted with the fit's;
         `fresh` ((20,) bool): joints seen anew this frame (on their own part, where the fit had them), which
-        need no recovery frame once their checks pass."""
+        need no recovery frame once their checks pass. `timestamp` (s): the frame's, where known; the motion
+        check allows the slack per sensor frame passed since the last output."""
         st = states.copy()
         doubt = np.zeros(20, bool)
-        pred = self.predict()
+        pred = self.predict(timestamp)
         if pred is not None:
-            doubt |= np.linalg.norm(positions - pred, axis=1) > PREDICTION_SLACK
+            doubt |= np.linalg.norm(positions - pred, axis=1) > PREDICTION_SLACK * self._frames_since(timestamp)
         proj = getattr(fit, "projector", None)
         if proj is not None:
             doubt[LIMB] |= proj.cost(positions[LIMB], LIMB_DEPTH_INSIDE) >= OFF_SURFACE
@@ -113,6 +127,15 @@ class ConfidenceCheck:
         st[(doubt | recovering) & (st == TRACKED)] = INFERRED
         return st
 
-    def remember(self, positions: np.ndarray) -> None:
-        """The pose the tracker output (after its filter): the motion model predicts from these."""
+    def remember(self, positions: np.ndarray, timestamp: float | None = None) -> None:
+        """The pose the tracker output (after its filter) at `timestamp` (s, where known): the motion model
+        predicts from these."""
         self._history = (self._history + [positions.copy()])[-2:]
+        self._times = (self._times + [float("nan") if timestamp is None else float(timestamp)])[-2:]
+
+
+def _sensor_frames(earlier: float | None, later: float | None) -> int:
+    """Whole sensor frames between two timestamps, 1 to MAX_FRAMES_COUNTED (1 where either is unknown)."""
+    if earlier is None or later is None or not np.isfinite(earlier) or not np.isfinite(later):
+        return 1
+    return int(np.clip(round((later - earlier) / SENSOR_FRAME_S), 1, MAX_FRAMES_COUNTED))

@@ -119,7 +119,7 @@ class SkeletonTracker:
         last = self.last_good
         self.last_proposals = None if self.forest is None else propose(self.forest, grid, person.mask)
         fit = fit_person(grid, person.mask, up, self.calibration, self._prev, self._prev_states, self._lateral,
-                         None if last is None else last.torso_centre, self.confidence.predict(),
+                         None if last is None else last.torso_centre, self.confidence.predict(ts),
                          self.confidence.settled, self.confidence.facing_steady, self.last_proposals)
         if fit is None or not np.all(np.isfinite(fit.positions)):
             self._lose(ts)
@@ -141,7 +141,7 @@ class SkeletonTracker:
             # with a forest, a hand hanging off a tracked wrist also needs its own evidence
             backed = None if self.forest is None else hands_backed(fit.positions, self.last_proposals, seen)
             report[hands_at_tracked_wrists(fit.positions, report, fit.projector, backed)] = TRACKED
-        pos, st = fit.positions, self.confidence.assess(fit.positions, report, fit, own, ends, seen)
+        pos, st = fit.positions, self.confidence.assess(fit.positions, report, fit, own, ends, seen, ts)
         if self.forest is not None:   # reported states only (the fit's history keeps its own)
             doubt |= disagreeing(pos, self.last_proposals, frame)
             st[doubt & (st == TRACKED)] = INFERRED
@@ -150,7 +150,7 @@ class SkeletonTracker:
             step = np.linalg.norm(pos - self._prev, axis=1, keepdims=True)
             w = self.settings.smoothing * np.clip(1.0 - step / 0.08, 0.0, 1.0)  # fast moves are not lagged
             pos = pos + w * (self._prev - pos)
-        self.confidence.remember(pos)
+        self.confidence.remember(pos, ts)
         self._prev, self._prev_states, self._lateral = pos.copy(), fit.states.copy(), fit.lateral
         self._person_centroid, self._last_seen = person.centroid, ts
         self.last_mask, self.last_good = person.mask, fit

@@ -6,7 +6,8 @@ from types import SimpleNamespace
 import numpy as np
 
 from kinect_retarget.core.skeletons import INFERRED, KINECT_V1, TRACKED
-from kinect_retarget.depth.confidence import LIMB, LIMB_WARMUP_FRAMES, RECOVERY_FRAMES, WARMUP_FRAMES, ConfidenceCheck
+from kinect_retarget.depth.confidence import (LIMB, LIMB_WARMUP_FRAMES, MAX_FRAMES_COUNTED, PREDICTION_SLACK,
+                                           RECOVERY_FRAMES, WARMUP_FRAMES, ConfidenceCheck)
 from kinect_retarget.sim.depth_scoring import score
 from kinect_retarget.depth.skeleton_tracker import track_depth_frames
 
@@ -144,3 +145,45 @@ def test_a_joint_seen_anew_needs_no_recovery_frame(rng):
     fresh[J("ElbowLeft")] = True
     st = chk.assess(pose, tracked, _fit(), fresh=fresh)
     assert st[J("ElbowLeft")] == TRACKED and st[J("HandLeft")] == INFERRED
+
+
+def _moving(chk, pose, tracked, frames, velocity):
+    """Poses at the given sensor frames of a body moving at `velocity` (m per 1/30 s), each assessed then
+    remembered with its timestamp; returns the states of the last."""
+    for f in frames:
+        moved = pose + velocity * f
+        st = chk.assess(moved, tracked, _fit(), timestamp=f / 30.0)
+        chk.remember(moved, f / 30.0)
+    return st
+
+
+def test_a_steady_motion_seen_at_uneven_frame_steps_stays_tracked(rng):
+    """A tracker slower than the sensor takes its newest frame: a body moving 5 cm a sensor frame (a hop's
+    torso), seen 2 then 4 frames apart, moved 10 then 20 cm between the poses checked. Counted in sensor
+    frames the motion is steady; counted per pose checked, the second step broke the torso's 10 cm slack."""
+    chk, pose, tracked = _steady(rng)
+    velocity = np.array([0.0, 0.05, 0.0])
+    st = _moving(chk, pose, tracked, [100, 102, 106, 108, 112], velocity)
+    assert np.all(st == TRACKED)
+    plain = ConfidenceCheck()                        # the same poses without their times: doubted
+    for _ in range(max(WARMUP_FRAMES, LIMB_WARMUP_FRAMES + RECOVERY_FRAMES) + 3):
+        plain.assess(pose, tracked, _fit())
+        plain.remember(pose)
+    for f in (100, 102):
+        plain.assess(pose + velocity * f, tracked, _fit())
+        plain.remember(pose + velocity * f)
+    assert plain.assess(pose + velocity * 106, tracked, _fit())[J("HipCenter")] == INFERRED
+
+
+def test_a_jump_is_still_doubted_at_a_slow_frame_rate_and_a_gap_is_not_a_licence(rng):
+    chk, pose, tracked = _steady(rng)
+    _moving(chk, pose, tracked, [200, 203], np.zeros(3))
+    jumped = pose.copy()
+    jumped[J("Spine")] += [0.0, 0.0, 0.45]           # 45 cm in 3 sensor frames: beyond 3 x 10 cm
+    assert chk.assess(jumped, tracked, _fit(), timestamp=206 / 30.0)[J("Spine")] == INFERRED
+    chk.reset()
+    chk, pose, tracked = _steady(rng)
+    _moving(chk, pose, tracked, [300, 301], np.zeros(3))
+    # a second without frames counts as MAX_FRAMES_COUNTED: 45 cm is still beyond its slack
+    assert MAX_FRAMES_COUNTED * PREDICTION_SLACK[J("Spine")] < 0.45
+    assert chk.assess(jumped, tracked, _fit(), timestamp=331 / 30.0)[J("Spine")] == INFERRED
