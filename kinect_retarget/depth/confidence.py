@@ -32,11 +32,13 @@ PREDICTION_SLACK = np.full(20, 0.25)
 PREDICTION_SLACK[TORSO + SIDE_TORSO] = 0.10
 VELOCITY_DAMPING = 0.5   # a fraction of the last frame's velocity is carried on (prediction, not extrapolation)
 # The sensor's frame interval. A tracker slower than the sensor takes its newest frame, so it sees every second
-# or third one, unevenly: the prediction and its slack count the sensor frames that passed. Without that, a
+# or third one, unevenly: the prediction counts the sensor frames that passed, and so does the torso's tight
+# slack (the limbs' wide one stays: grown too, it let a hopping leg 20-40 cm off stay tracked). Without that, a
 # hop streamed to a slow 2-core machine (10 frames/s tracked) had its torso demoted whenever a step of 4
 # frames followed one of 2.
 SENSOR_FRAME_S = 1.0 / 30.0
 MAX_FRAMES_COUNTED = 4   # a tracker at 7.5 frames/s; a longer gap is frames lost, and no motion carries over it
+SLACK_PER_FRAME = np.isin(np.arange(20), TORSO + SIDE_TORSO)
 MIN_EXTREMITIES = 3      # of head, hands and feet; fewer and the labelling of what was found is a guess
 WARMUP_FRAMES = 6        # frames after (re)acquisition before the fit counts as settled (0.2 s)
 # frames after (re)acquisition during which limbs are reported inferred (0.1 s): on real depth the limbs of
@@ -94,12 +96,13 @@ class ConfidenceCheck:
         `ends_seen`: extremities ("head", "HandLeft", ...) the body-part forest saw, counted with the fit's;
         `fresh` ((20,) bool): joints seen anew this frame (on their own part, where the fit had them), which
         need no recovery frame once their checks pass. `timestamp` (s): the frame's, where known; the motion
-        check allows the slack per sensor frame passed since the last output."""
+        check predicts for the sensor frames passed since the last output (the torso's slack per frame)."""
         st = states.copy()
         doubt = np.zeros(20, bool)
         pred = self.predict(timestamp)
         if pred is not None:
-            doubt |= np.linalg.norm(positions - pred, axis=1) > PREDICTION_SLACK * self._frames_since(timestamp)
+            n = self._frames_since(timestamp)
+            doubt |= np.linalg.norm(positions - pred, axis=1) > np.where(SLACK_PER_FRAME, n, 1) * PREDICTION_SLACK
         proj = getattr(fit, "projector", None)
         if proj is not None:
             doubt[LIMB] |= proj.cost(positions[LIMB], LIMB_DEPTH_INSIDE) >= OFF_SURFACE

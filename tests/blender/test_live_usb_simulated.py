@@ -20,11 +20,11 @@ def test_live_usb_simulated_poses_records_and_bakes(tmp_path):
     take = load_take(rec)
     assert take.skeleton.name == "kinect_v1" and take.frame_count == stats["recorded"] >= 30
     # the torso is tracked most of the time; limbs are honestly inferred often (hidden, searched, settling
-    # after the person is found: about half of the hop's limb samples, docs/depth_tracking.md). How often
-    # depends on the machine: the tracker takes the newest frame of a 30 Hz stream, and on a slow 2-core
-    # machine (10 frames/s: every third frame of the hop) the torso was tracked in 68-88 % of frames, the
-    # trackers of stops 41 and 42 alike (seven runs each), above 80 % on faster ones
+    # after the person is found: about half of the hop's limb samples, docs/depth_tracking.md). The tracker
+    # takes the newest frame of a 30 Hz stream, so a slow machine sees the hop in uneven steps; the motion
+    # check counts the sensor frames that passed (confidence.py): on a slow 2-core machine (5-7 frames/s)
+    # the torso was tracked in 85-91 % of frames (six runs); counting steps as frames, 64-76 % (four runs)
     torso = [take.skeleton.index(n) for n in ("HipCenter", "Spine", "ShoulderCenter", "Head")]
-    assert (take.states[:, torso] == 2).mean() > 0.6
+    assert (take.states[:, torso] == 2).mean() > 0.75
     assert take.tracked_fraction > 0.35
     assert out.is_file() and stats["action"]
