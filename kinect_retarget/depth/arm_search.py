@@ -48,7 +48,7 @@ COVER_TOL = 0.08       # m: depth agreement for a covered evidence cell
 W_COVER = 0.8          # reward per sample on arm evidence, against a cost of 1 for a free-space violation
 ON_BODY_COST = 0.2     # a bone on the torso's own surface: an arm lying there would stand out in front of it
 W_PREVIOUS = 0.5       # per metre from the previous frame's elbow and hand
-MAX_HAND_STEP, W_JUMP = 0.25, 2.0   # m a searched hand moves in a frame for free; cost per metre beyond
+MAX_HAND_STEP, W_JUMP = 0.25, 2.0   # m a searched hand moves a sensor frame for free; cost per metre beyond
 INSIDE_COST = 2.0      # an elbow or hand inside the torso
 TORSO_HALF_WIDTH = 0.1   # fraction of height: the trunk's half width seen from the front
 IN_FRONT = 0.06        # m in front of the chest's surface: an arm, not the chest
@@ -238,14 +238,16 @@ def best_elbow(scorer: ArmScorer, shoulder, candidates: np.ndarray, wrist, H, pr
 
 
 def fit_arms(pos, st, xyz, mask, proj, frame: TorsoFrame, H, prev=None, head_region=None,
-             settled: bool = False, facing_steady: bool = False) -> None:
+             settled: bool = False, facing_steady: bool = False, frames_passed: int = 1) -> None:
     """The arms of one fitted frame, in place (`pos`, `st`: the fit's 20 joints and states). A tracked hand
     keeps its wrist and gets the elbow its IK circle's depth backs; an arm whose hand is not a tracked
     extremity gets the pose that best explains the depth, reported inferred. Each arm explains its own
     cells: a tracked arm's are withheld, and when two searched arms claim the same cells the weaker looks
     again without them (a hidden far arm must not borrow the near arm's). Once the tracking has `settled`,
-    a searched hand does not jump more than MAX_HAND_STEP in a frame for free (a wrong early guess must
-    still be free to move). A searched arm explained well enough, of a performer who has been facing the
+    a searched hand does not jump more than MAX_HAND_STEP a sensor frame for free (a wrong early guess must
+    still be free to move; `frames_passed`: the sensor's frames since the last pose). On real depth tracked at
+    uneven steps of 2-4 frames, as a slow machine sees it, subjects 3-4's hands and wrists went 9.6 -> 8.7 cm
+    with the step per sensor frame instead of per frame tracked. A searched arm explained well enough, of a performer who has been facing the
     sensor (`facing_steady`) and still is, reports its seen elbow and wrist tracked."""
     todo = [s for s in SIDES if st[J[f"Hand{s}"]] != TRACKED]
     evidence = arm_evidence(xyz, mask, pos, frame, head_region)
@@ -267,7 +269,7 @@ def fit_arms(pos, st, xyz, mask, proj, frame: TorsoFrame, H, prev=None, head_reg
     def search(s, ev):
         pe, ph = (None, None) if prev is None else (prev[J[f"Elbow{s}"]], prev[J[f"Hand{s}"]])
         return search_arm(ArmScorer(proj, ev, frame), pos[J[f"Shoulder{s}"]], *lengths, H, pe, ph,
-                          MAX_HAND_STEP if settled else None)
+                          MAX_HAND_STEP * frames_passed if settled else None)
 
     found = {s: search(s, evidence) for s in todo}
     if len(todo) == 2:

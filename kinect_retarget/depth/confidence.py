@@ -75,7 +75,7 @@ class ConfidenceCheck:
         """Settled, and facing the sensor for as long: a turn's mirror image has left the history."""
         return self._facing_frames >= WARMUP_FRAMES
 
-    def _frames_since(self, timestamp: float | None) -> int:
+    def frames_since(self, timestamp: float | None) -> int:
         """Sensor frames from the last output pose to `timestamp` (1 where either time is unknown)."""
         return _sensor_frames(self._times[-1] if self._times else None, timestamp)
 
@@ -86,7 +86,7 @@ class ConfidenceCheck:
         if len(self._history) == 1:
             return self._history[-1]
         a, b = self._history[-2], self._history[-1]
-        ratio = self._frames_since(timestamp) / _sensor_frames(self._times[-2], self._times[-1])
+        ratio = self.frames_since(timestamp) / _sensor_frames(self._times[-2], self._times[-1])
         return b + VELOCITY_DAMPING * ratio * (b - a)
 
     def assess(self, positions: np.ndarray, states: np.ndarray, fit, own=None, ends_seen=frozenset(),
@@ -101,7 +101,7 @@ class ConfidenceCheck:
         doubt = np.zeros(20, bool)
         pred = self.predict(timestamp)
         if pred is not None:
-            n = self._frames_since(timestamp)
+            n = self.frames_since(timestamp)
             doubt |= np.linalg.norm(positions - pred, axis=1) > np.where(SLACK_PER_FRAME, n, 1) * PREDICTION_SLACK
         proj = getattr(fit, "projector", None)
         if proj is not None:

@@ -103,13 +103,15 @@ class Projector:
 def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states: np.ndarray | None,
                prev_lateral: np.ndarray | None, prev_centre: np.ndarray | None = None,
                predicted: np.ndarray | None = None, settled: bool = False,
-               facing_steady: bool = False, proposals=None) -> FitResult | None:
+               facing_steady: bool = False, proposals=None,
+               frames_passed: int = 1) -> FitResult | None:
     """One frame's skeleton for the segmented person. `prev`/`prev_states`/`prev_lateral`: the last output;
     `predicted`: where the motion so far says the joints are now (continuity for left/right labels);
     `settled`: the person has been tracked past the first frames (their pose is no longer a first guess);
     `facing_steady`: and has faced the sensor for those frames (no turn's mirror image left in the history);
     `proposals`: the frame's body-part proposals (part_proposals.propose), whose confident shoulders the limbs
-    are fitted from."""
+    are fitted from; `frames_passed`: the sensor's frames since the last output (a tracker slower than the
+    sensor skips some)."""
     rows, cols = np.nonzero(mask_full)
     r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
     # the person's bounding box of the tracker's grid (no coarser: coarser cells merge arms with the body)
@@ -188,7 +190,7 @@ def fit_person(grid, mask_full, up, calib, prev: np.ndarray | None, prev_states:
             legs_clipped += fit_limb(scene, root, mid, end, tip, r1, r2, d_tip, d_end, s, assign.get(s))
     if ARM_SEARCH:
         fit_arms(pos, st, xyz, mask, proj, TorsoFrame(centre, axis, lat, facing, pos, H), H, prev, head_region,
-                 settled, facing_steady)
+                 settled, facing_steady, frames_passed)
     # without the head top or the shoulders the torso's place along its axis is a guess; seen more than
     # TURNED_DEG from the front, shoulders and hips overlap in depth: say so instead of claiming them
     if shift is None:

@@ -120,7 +120,8 @@ class SkeletonTracker:
         self.last_proposals = None if self.forest is None else propose(self.forest, grid, person.mask)
         fit = fit_person(grid, person.mask, up, self.calibration, self._prev, self._prev_states, self._lateral,
                          None if last is None else last.torso_centre, self.confidence.predict(ts),
-                         self.confidence.settled, self.confidence.facing_steady, self.last_proposals)
+                         self.confidence.settled, self.confidence.facing_steady, self.last_proposals,
+                         self.confidence.frames_since(ts))
         if fit is None or not np.all(np.isfinite(fit.positions)):
             self._lose(ts)
             return self._none("person found but no skeleton fitted")

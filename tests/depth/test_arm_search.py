@@ -218,3 +218,32 @@ def test_band_surfaces_are_set_back_to_their_line_never_forward():
     assert np.allclose(out[3:5], 0.3 - 0.01 * bands[3:5])
     assert np.allclose(np.delete(out, [3, 4]), np.delete(level, [3, 4]))
     assert np.array_equal(arm_search._no_nearer_than_line(bands[:3], level[:3]), level[:3])
+
+
+def test_a_searched_hand_may_move_farther_when_more_sensor_frames_passed(hand_on_face, monkeypatch):
+    """A tracker slower than the sensor sees every second or third frame: the searched hand's free step
+    (MAX_HAND_STEP a sensor frame) counts the frames that passed, as the tracker's motion check does."""
+    steps, real = [], arm_search.search_arm
+
+    def spy(scorer, shoulder, l1, l2, lh, H, prev_elbow=None, prev_hand=None, max_step=None):
+        steps.append(max_step)
+        return real(scorer, shoulder, l1, l2, lh, H, prev_elbow, prev_hand, max_step)
+
+    monkeypatch.setattr(arm_search, "search_arm", spy)
+    calls, real_fit = [], skeleton_fit.fit_arms
+
+    def fit_spy(*args, **kw):
+        calls.append(args)
+        return real_fit(*args, **kw)
+
+    monkeypatch.setattr(skeleton_fit, "fit_arms", fit_spy)
+    tracker = SkeletonTracker(gravity=hand_on_face.gravity)
+    t0 = float(hand_on_face.times[0])
+    for i, frames in enumerate((0, 3, 5)):          # the sensor's frames 0, 3 and 5
+        tracker.update(hand_on_face.mm[i], t0 + frames / 30.0)
+    assert [c[11] for c in calls] == [1, 3, 2]
+    pos, st, *rest = calls[-1][:9]
+    for passed in (1, 3):                            # once settled, the last frame's arms searched again
+        steps.clear()
+        real_fit(pos.copy(), st.copy(), *rest, settled=True, facing_steady=False, frames_passed=passed)
+        assert steps and all(s == pytest.approx(passed * arm_search.MAX_HAND_STEP) for s in steps)
