@@ -247,8 +247,9 @@ def fit_arms(pos, st, xyz, mask, proj, frame: TorsoFrame, H, prev=None, head_reg
     a searched hand does not jump more than MAX_HAND_STEP a sensor frame for free (a wrong early guess must
     still be free to move; `frames_passed`: the sensor's frames since the last pose). On real depth tracked at
     uneven steps of 2-4 frames, as a slow machine sees it, subjects 3-4's hands and wrists went 9.6 -> 8.7 cm
-    with the step per sensor frame instead of per frame tracked. A searched arm explained well enough, of a performer who has been facing the
-    sensor (`facing_steady`) and still is, reports its seen elbow and wrist tracked."""
+    with the step per sensor frame instead of per frame tracked. A searched arm explained well enough, of a
+    performer who has been facing the sensor (`facing_steady`) and still is, reports its seen elbow and wrist
+    tracked."""
     todo = [s for s in SIDES if st[J[f"Hand{s}"]] != TRACKED]
     evidence = arm_evidence(xyz, mask, pos, frame, head_region)
     lengths = (bm.UPPER_ARM * H, bm.FOREARM * H, bm.HAND * H)
